@@ -1,0 +1,254 @@
+//! A chain: its shapes (base and view shapes), the rest shape blended from them, its particles, and the
+//! interpolated output pose.
+
+use glam::{Quat, Vec3};
+
+use super::arena::Id;
+use super::blend::blend_into;
+use super::error::{Error, Result};
+use super::math::{Transform, direction, nlerp_shorter, swing_to};
+use super::params::ChainParams;
+use super::rod::RodState;
+use super::shape::{EncodedShape, Shape, ShapeFrame};
+use super::weights::{ViewWeighting, blend_weights};
+
+/// Marker type for view shape ids.
+pub enum ViewShapeTag {}
+pub type ViewShapeId = Id<ViewShapeTag>;
+
+/// A view shape as stored by its chain.
+#[derive(Clone, Debug)]
+pub(crate) struct ViewShape {
+    pub id: ViewShapeId,
+    pub weighting: ViewWeighting,
+    pub encoded: EncodedShape,
+}
+
+/// A view direction closer than this (in unit-vector distance, ~radians) to the last blended one reuses
+/// the last blend.
+const VIEW_EPSILON: f32 = 1e-6;
+
+pub struct Chain {
+    pub params: ChainParams,
+    pub(crate) frame: ShapeFrame,
+    base: EncodedShape,
+    /// Each joint's bone axis in its own frame (from the base shape); the tip repeats its parent's.
+    bone_axes: Vec<Vec3>,
+    pub(crate) views: Vec<ViewShape>,
+    weights: Vec<f32>,
+    blended: EncodedShape,
+    /// The rest shape the solver pulls towards (anchor frame).
+    pub(crate) rest: Shape,
+    /// The rest shape of the last substep; differs from `rest` while `rest_changed`.
+    pub(crate) rest_used: Shape,
+    pub(crate) rest_changed: bool,
+    blended_for: Option<Vec3>,
+    shapes_dirty: bool,
+    pub(crate) state: RodState,
+    /// False until the first step places the particles under a known anchor (and after a reset).
+    pub(crate) placed: bool,
+    pub(crate) half_kick: bool,
+    /// The anchor of the last step (world) and the one supplied for the next (own anchors only).
+    pub(crate) anchor: Transform,
+    pub(crate) anchor_pending: Transform,
+    /// The last two internal states in the anchor frame, for render interpolation.
+    pub(crate) local_previous: Vec<Transform>,
+    pub(crate) local_current: Vec<Transform>,
+    /// Interpolated, skinning-ready pose in the anchor frame.
+    pub(crate) output: Vec<Transform>,
+}
+
+impl Chain {
+    pub fn new(params: ChainParams, joints: &[Transform]) -> Result<Self> {
+        params.validate()?;
+        let base_shape = Shape::from_joints(joints)?;
+        let n = base_shape.len();
+        let frame = ShapeFrame::from_base(&base_shape);
+        let base = EncodedShape::encode(&base_shape, frame.reference);
+        let local: Vec<Transform> = base_shape
+            .positions
+            .iter()
+            .zip(&base_shape.orientations)
+            .map(|(p, q)| Transform::new(*p, *q))
+            .collect();
+        let mut chain = Self {
+            params,
+            bone_axes: bone_axes(&base_shape),
+            frame,
+            base,
+            views: Vec::new(),
+            weights: Vec::new(),
+            blended: EncodedShape::identity(n),
+            rest: base_shape.clone(),
+            rest_used: base_shape.clone(),
+            rest_changed: false,
+            blended_for: None,
+            shapes_dirty: true,
+            state: RodState::at_rest(&base_shape, &Transform::IDENTITY),
+            placed: false,
+            half_kick: true,
+            anchor: Transform::IDENTITY,
+            anchor_pending: Transform::IDENTITY,
+            local_previous: local.clone(),
+            local_current: local.clone(),
+            output: local,
+        };
+        chain.update_rest(None);
+        chain.rest_used.clone_from(&chain.rest);
+        chain.rest_changed = false;
+        chain.write_output(0.0);
+        Ok(chain)
+    }
+
+    pub fn joint_count(&self) -> usize {
+        self.rest.len()
+    }
+
+    /// Validates and encodes a view shape for this chain (lengths and root come from the base).
+    pub(crate) fn encode_view_shape(&self, joints: &[Transform]) -> Result<EncodedShape> {
+        if joints.len() != self.joint_count() {
+            return Err(Error::invalid_argument(format!(
+                "a view shape needs as many joints as its chain ({}), got {}",
+                self.joint_count(),
+                joints.len()
+            )));
+        }
+        let shape = Shape::from_joints(joints)?;
+        Ok(EncodedShape::encode(&shape, self.frame.reference))
+    }
+
+    pub(crate) fn mark_shapes_dirty(&mut self) {
+        self.shapes_dirty = true;
+    }
+
+    /// Replaces the base shape (same joint count). View shapes keep their bends and take the new lengths.
+    pub(crate) fn set_base_shape(&mut self, joints: &[Transform]) -> Result<()> {
+        if joints.len() != self.joint_count() {
+            return Err(Error::invalid_argument(format!(
+                "the base shape must keep the chain's {} joints, got {}",
+                self.joint_count(),
+                joints.len()
+            )));
+        }
+        let shape = Shape::from_joints(joints)?;
+        let frame = ShapeFrame::from_base(&shape);
+        for view in &mut self.views {
+            view.encoded
+                .rebase_reference(self.frame.reference, frame.reference);
+        }
+        self.base = EncodedShape::encode(&shape, frame.reference);
+        self.bone_axes = bone_axes(&shape);
+        self.frame = frame;
+        self.shapes_dirty = true;
+        Ok(())
+    }
+
+    /// Re-blends the rest shape for view direction `view` when it or the shapes changed. A changed rest
+    /// shape is flagged so the next substep can suppress the momentum it would inject.
+    pub(crate) fn update_rest(&mut self, view: Option<Vec3>) {
+        let view_moved = match (view, self.blended_for) {
+            (Some(v), Some(b)) => (v - b).length() > VIEW_EPSILON,
+            (a, b) => a.is_some() != b.is_some(),
+        };
+        if !self.shapes_dirty && (self.views.is_empty() || !view_moved) {
+            return;
+        }
+        self.shapes_dirty = false;
+        self.blended_for = view;
+        if self.views.is_empty() || view.is_none() {
+            self.blended.clone_from(&self.base);
+        } else {
+            let d = view.unwrap_or(Vec3::Z);
+            self.weights.resize(self.views.len(), 0.0);
+            let weightings = self.views.iter().map(|v| v.weighting);
+            let w0 = blend_weights(d, weightings, &mut self.weights);
+            let views = self
+                .views
+                .iter()
+                .zip(self.weights.iter())
+                .map(|(v, w)| (&v.encoded, *w));
+            blend_into(&self.base, w0, views, &mut self.blended);
+        }
+        let n = self.joint_count();
+        let mut positions = std::mem::take(&mut self.rest.positions);
+        self.blended.decode_into(&self.frame, &mut positions);
+        self.rest.positions = positions;
+        for j in 0..n {
+            let q = self.blended.orientations[j];
+            self.rest.orientations[j] = match (j + 1 < n)
+                .then(|| direction(self.rest.positions[j + 1] - self.rest.positions[j]))
+            {
+                Some(Some(dir)) => swing_to(q, self.bone_axes[j], dir),
+                _ => q,
+            };
+        }
+        if self.rest != self.rest_used {
+            self.rest_changed = true;
+        }
+    }
+
+    /// Particles back at the rest shape under `anchor` (relative to the engine origin), at rest.
+    pub(crate) fn place(&mut self, anchor: &Transform) {
+        self.rest_used.clone_from(&self.rest);
+        self.rest_changed = false;
+        self.state.place_at_rest(&self.rest, anchor);
+        for (j, local) in self.local_current.iter_mut().enumerate() {
+            *local = Transform::new(self.rest.positions[j], self.rest.orientations[j]);
+        }
+        self.local_previous.clone_from(&self.local_current);
+        self.placed = true;
+        self.half_kick = true;
+    }
+
+    /// Records the state after a substep under `anchor` as the newest internal pose.
+    pub(crate) fn capture_local(&mut self, anchor: &Transform) {
+        std::mem::swap(&mut self.local_previous, &mut self.local_current);
+        let inverse = anchor.inverse();
+        for (j, local) in self.local_current.iter_mut().enumerate() {
+            *local = Transform::new(
+                inverse.transform_point(self.state.x[j]),
+                (inverse.rotation * self.state.q[j]).normalize(),
+            );
+        }
+    }
+
+    /// Output pose at fraction `t` between the last two internal states, with every joint's bone axis
+    /// swung onto the next joint (skinning-ready) and its twist kept.
+    pub(crate) fn write_output(&mut self, t: f32) {
+        let n = self.joint_count();
+        for j in 0..n {
+            let (a, b) = (&self.local_previous[j], &self.local_current[j]);
+            self.output[j] = Transform::new(
+                a.position.lerp(b.position, t),
+                nlerp_shorter(a.rotation, b.rotation, t),
+            );
+        }
+        for j in 0..n - 1 {
+            if let Some(dir) = direction(self.output[j + 1].position - self.output[j].position) {
+                self.output[j].rotation = swing_to(self.output[j].rotation, self.bone_axes[j], dir);
+            }
+        }
+    }
+
+    pub(crate) fn view_shape_index(&self, id: ViewShapeId) -> Option<usize> {
+        self.views.iter().position(|v| v.id == id)
+    }
+}
+
+fn bone_axes(shape: &Shape) -> Vec<Vec3> {
+    let n = shape.len();
+    let mut axes = Vec::with_capacity(n);
+    for j in 0..n - 1 {
+        let world = shape.positions[j + 1] - shape.positions[j];
+        axes.push(direction(shape.orientations[j].inverse() * world).unwrap_or(Vec3::Y));
+    }
+    let tip = axes[n - 2];
+    axes.push(tip);
+    axes
+}
+
+/// Rotation of `q` relative to `parent`, the form Unity's `localRotation` takes.
+#[inline]
+pub(crate) fn relative_rotation(parent: Quat, q: Quat) -> Quat {
+    (parent.inverse() * q).normalize()
+}

@@ -1,0 +1,677 @@
+//! The engine: one per character. Owns chains and view shapes, the clock, and the solver scratch; one
+//! `step` advances every chain.
+
+use std::hash::{Hash, Hasher};
+use std::sync::atomic::{AtomicU16, Ordering};
+
+use glam::{Quat, Vec3};
+
+use super::arena::{Arena, Id, Kind};
+use super::chain::{Chain, ViewShape, ViewShapeId, relative_rotation};
+use super::error::{Error, Result};
+use super::math::{Transform, direction, rotation_angle};
+use super::params::{AnchorSource, ChainParams, EngineSettings};
+use super::rod::{RodScratch, SubstepInput, substep};
+use super::weights::{ViewWeighting, view_direction};
+
+pub type ChainId = Id<Chain>;
+
+/// Counters a host can show in a profiler overlay.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stats {
+    pub chain_count: u32,
+    pub joint_count: u32,
+    /// Internal substeps run by the last `step`.
+    pub substeps_last_step: u32,
+    /// Chains that cost nothing in the last step (sleeping or disabled). Always 0 until sleeping lands.
+    pub chains_asleep: u32,
+    /// Substeps where the direct inextensibility solve failed and the fallback ran.
+    pub solver_fallbacks: u64,
+    pub substeps_total: u64,
+    /// Simulated seconds dropped because a call needed more than `max_substeps`.
+    pub time_dropped: f64,
+    /// Simulated seconds advanced (after time scale), including the part not yet run as a substep.
+    pub simulated_time: f64,
+}
+
+/// Salts ids so that an id from one engine is rejected by another. Only distinguishes engines; it never
+/// influences simulation results, so it is the one piece of process-wide state the library keeps.
+static NEXT_SALT: AtomicU16 = AtomicU16::new(1);
+
+pub struct Engine {
+    settings: EngineSettings,
+    chains: Arena<Chain>,
+    /// Chain slots in creation order: the order of every batched read and write.
+    order: Vec<u32>,
+    view_shapes: Arena<u32>,
+    accumulator: f64,
+    /// World position the particle state is relative to: the view reference position of the last step,
+    /// so a character far from the world origin keeps full float precision.
+    origin: Vec3,
+    view_reference: Option<Transform>,
+    view: Option<Vec3>,
+    joint_count: usize,
+    scratch: RodScratch,
+    stats: Stats,
+}
+
+impl Engine {
+    pub fn new(settings: EngineSettings) -> Result<Self> {
+        settings.validate()?;
+        let salt = NEXT_SALT.fetch_add(1, Ordering::Relaxed);
+        Ok(Self {
+            settings,
+            chains: Arena::new(Kind::Chain, salt),
+            order: Vec::new(),
+            view_shapes: Arena::new(Kind::ViewShape, salt),
+            accumulator: 0.0,
+            origin: Vec3::ZERO,
+            view_reference: None,
+            view: None,
+            joint_count: 0,
+            scratch: RodScratch::default(),
+            stats: Stats::default(),
+        })
+    }
+
+    pub fn settings(&self) -> &EngineSettings {
+        &self.settings
+    }
+
+    pub fn set_settings(&mut self, settings: EngineSettings) -> Result<()> {
+        settings.validate()?;
+        self.settings = settings;
+        Ok(())
+    }
+
+    pub fn set_gravity(&mut self, gravity: Vec3) -> Result<()> {
+        self.set_settings(EngineSettings {
+            gravity,
+            ..self.settings
+        })
+    }
+
+    pub fn chain_count(&self) -> usize {
+        self.order.len()
+    }
+
+    pub fn joint_count(&self) -> usize {
+        self.joint_count
+    }
+
+    pub fn stats(&self) -> Stats {
+        Stats {
+            chain_count: self.order.len() as u32,
+            joint_count: self.joint_count as u32,
+            ..self.stats
+        }
+    }
+
+    // ---- chains -------------------------------------------------------------------------------------
+
+    pub fn create_chain(&mut self, params: ChainParams, joints: &[Transform]) -> Result<ChainId> {
+        if !self.chains.has_room() {
+            return Err(Error::capacity(
+                "the engine holds the maximum number of chains",
+            ));
+        }
+        let chain = Chain::new(params, joints)?;
+        let n = chain.joint_count();
+        let id = self.chains.insert(chain).expect("room checked above");
+        self.order
+            .push(self.chains.index_of(id).expect("just inserted") as u32);
+        self.joint_count += n;
+        Ok(id)
+    }
+
+    fn chain(&self, id: ChainId) -> Result<&Chain> {
+        self.chains.get(id).ok_or_else(|| {
+            Error::invalid_id(format!(
+                "chain id {:#x} is null, stale or foreign",
+                id.to_bits()
+            ))
+        })
+    }
+
+    fn chain_mut(&mut self, id: ChainId) -> Result<&mut Chain> {
+        self.chains.get_mut(id).ok_or_else(|| {
+            Error::invalid_id(format!(
+                "chain id {:#x} is null, stale or foreign",
+                id.to_bits()
+            ))
+        })
+    }
+
+    pub fn is_chain_valid(&self, id: ChainId) -> bool {
+        self.chains.get(id).is_some()
+    }
+
+    pub fn destroy_chain(&mut self, id: ChainId) -> Result<()> {
+        let index = self.chains.index_of(id).ok_or_else(|| {
+            Error::invalid_id(format!(
+                "chain id {:#x} is null, stale or foreign",
+                id.to_bits()
+            ))
+        })?;
+        let chain = self.chains.remove(id).expect("checked above");
+        for view in &chain.views {
+            self.view_shapes.remove(Id::from_bits(view.id.to_bits()));
+        }
+        self.order.retain(|&slot| slot as usize != index);
+        self.joint_count -= chain.joint_count();
+        Ok(())
+    }
+
+    pub fn chain_joint_count(&self, id: ChainId) -> Result<usize> {
+        Ok(self.chain(id)?.joint_count())
+    }
+
+    pub fn chain_params(&self, id: ChainId) -> Result<ChainParams> {
+        Ok(self.chain(id)?.params)
+    }
+
+    pub fn set_chain_params(&mut self, id: ChainId, params: ChainParams) -> Result<()> {
+        params.validate()?;
+        self.chain_mut(id)?.params = params;
+        Ok(())
+    }
+
+    pub fn set_base_shape(&mut self, id: ChainId, joints: &[Transform]) -> Result<()> {
+        self.chain_mut(id)?.set_base_shape(joints)
+    }
+
+    /// Back to the rest shape under the current anchor, at rest, at the next step.
+    pub fn reset_chain(&mut self, id: ChainId) -> Result<()> {
+        self.chain_mut(id)?.placed = false;
+        Ok(())
+    }
+
+    pub fn reset_all(&mut self) {
+        for &slot in &self.order {
+            if let Some(chain) = self.chains.at_mut(slot as usize) {
+                chain.placed = false;
+            }
+        }
+    }
+
+    /// Anchors for the next step, one per chain in creation order (entries of chains anchored to the view
+    /// reference are validated but unused).
+    pub fn set_anchors(&mut self, anchors: &[Transform]) -> Result<()> {
+        if anchors.len() != self.order.len() {
+            return Err(Error::invalid_argument(format!(
+                "set_anchors needs one transform per chain ({}), got {}",
+                self.order.len(),
+                anchors.len()
+            )));
+        }
+        for (i, anchor) in anchors.iter().enumerate() {
+            validate_transform(anchor)
+                .map_err(|e| Error::invalid_argument(format!("anchor {i}: {e}")))?;
+        }
+        for (&slot, anchor) in self.order.iter().zip(anchors) {
+            let chain = self
+                .chains
+                .at_mut(slot as usize)
+                .expect("order holds live chains");
+            chain.anchor_pending = Transform::new(anchor.position, anchor.rotation.normalize());
+        }
+        Ok(())
+    }
+
+    // ---- view shapes --------------------------------------------------------------------------------
+
+    pub fn add_view_shape(
+        &mut self,
+        chain_id: ChainId,
+        view_direction: Vec3,
+        joints: &[Transform],
+        influence: f32,
+    ) -> Result<ViewShapeId> {
+        let slot = self.chains.index_of(chain_id).ok_or_else(|| {
+            Error::invalid_id(format!(
+                "chain id {:#x} is null, stale or foreign",
+                chain_id.to_bits()
+            ))
+        })?;
+        let direction = validate_direction(view_direction)?;
+        validate_influence(influence)?;
+        let chain = self.chains.at(slot).expect("checked");
+        let encoded = chain.encode_view_shape(joints)?;
+        if !self.view_shapes.has_room() {
+            return Err(Error::capacity(
+                "the engine holds the maximum number of view shapes",
+            ));
+        }
+        let id = Id::from_bits(
+            self.view_shapes
+                .insert(slot as u32)
+                .expect("room checked")
+                .to_bits(),
+        );
+        let chain = self.chains.at_mut(slot).expect("checked");
+        chain.views.push(ViewShape {
+            id,
+            weighting: ViewWeighting {
+                direction,
+                influence,
+            },
+            encoded,
+        });
+        chain.mark_shapes_dirty();
+        Ok(id)
+    }
+
+    fn view_shape_mut(&mut self, id: ViewShapeId) -> Result<(&mut Chain, usize)> {
+        let err = || {
+            Error::invalid_id(format!(
+                "view shape id {:#x} is null, stale or foreign",
+                id.to_bits()
+            ))
+        };
+        let slot = *self
+            .view_shapes
+            .get(Id::from_bits(id.to_bits()))
+            .ok_or_else(err)?;
+        let chain = self.chains.at_mut(slot as usize).ok_or_else(err)?;
+        let index = chain.view_shape_index(id).ok_or_else(err)?;
+        Ok((chain, index))
+    }
+
+    pub fn set_view_shape_influence(&mut self, id: ViewShapeId, influence: f32) -> Result<()> {
+        validate_influence(influence)?;
+        let (chain, index) = self.view_shape_mut(id)?;
+        chain.views[index].weighting.influence = influence;
+        chain.mark_shapes_dirty();
+        Ok(())
+    }
+
+    pub fn set_view_shape_direction(
+        &mut self,
+        id: ViewShapeId,
+        view_direction: Vec3,
+    ) -> Result<()> {
+        let direction = validate_direction(view_direction)?;
+        let (chain, index) = self.view_shape_mut(id)?;
+        chain.views[index].weighting.direction = direction;
+        chain.mark_shapes_dirty();
+        Ok(())
+    }
+
+    pub fn set_view_shape_joints(&mut self, id: ViewShapeId, joints: &[Transform]) -> Result<()> {
+        let (chain, index) = self.view_shape_mut(id)?;
+        let encoded = chain.encode_view_shape(joints)?;
+        chain.views[index].encoded = encoded;
+        chain.mark_shapes_dirty();
+        Ok(())
+    }
+
+    pub fn remove_view_shape(&mut self, id: ViewShapeId) -> Result<()> {
+        let (chain, index) = self.view_shape_mut(id)?;
+        chain.views.remove(index);
+        chain.mark_shapes_dirty();
+        self.view_shapes.remove(Id::from_bits(id.to_bits()));
+        Ok(())
+    }
+
+    pub fn view_shape_count(&self, chain_id: ChainId) -> Result<usize> {
+        Ok(self.chain(chain_id)?.views.len())
+    }
+
+    // ---- stepping -----------------------------------------------------------------------------------
+
+    /// Advances the simulation by `dt` seconds of real time (scaled by `time_scale`) with the camera at
+    /// `camera` and the view reference joint K at `view_reference` (world space). Inputs are validated
+    /// before anything changes; `dt == 0` changes nothing.
+    pub fn step(&mut self, dt: f32, camera: Vec3, view_reference: Transform) -> Result<()> {
+        if !(dt.is_finite() && dt >= 0.0) {
+            return Err(Error::invalid_argument(format!(
+                "dt must be finite and >= 0, got {dt}"
+            )));
+        }
+        if !camera.is_finite() {
+            return Err(Error::invalid_argument("camera position must be finite"));
+        }
+        validate_transform(&view_reference)
+            .map_err(|e| Error::invalid_argument(format!("view reference: {e}")))?;
+        if dt == 0.0 {
+            return Ok(());
+        }
+        let k = Transform::new(view_reference.position, view_reference.rotation.normalize());
+
+        // Rebase the particle state on the new origin.
+        let origin = k.position;
+        let shift = self.origin - origin;
+        if shift != Vec3::ZERO {
+            for &slot in &self.order {
+                self.chains
+                    .at_mut(slot as usize)
+                    .expect("live")
+                    .state
+                    .translate(shift);
+            }
+        }
+        self.origin = origin;
+        if let Some(d) = view_direction(camera, &k) {
+            self.view = Some(d);
+        }
+        self.view_reference = Some(k);
+
+        // Clock: fixed substeps from an accumulator, capped.
+        let settings = self.settings;
+        let h = 1.0 / settings.substep_rate as f64;
+        let simulated = dt as f64 * settings.time_scale as f64;
+        let before = self.accumulator;
+        let mut available = before + simulated;
+        let mut substeps = (available / h).floor() as u64;
+        let mut dropped = 0.0;
+        if substeps > settings.max_substeps as u64 {
+            substeps = settings.max_substeps as u64;
+            dropped = available - substeps as f64 * h;
+            available = substeps as f64 * h;
+        }
+        let after = (available - substeps as f64 * h).max(0.0);
+        // Fraction of this call's motion reached at the end of each substep, for anchor interpolation.
+        let span = available - before;
+        let progress = |s: u64| {
+            if span > 0.0 {
+                (((s + 1) as f64 * h - before) / span).clamp(0.0, 1.0) as f32
+            } else {
+                1.0
+            }
+        };
+
+        let mut fallbacks = 0u64;
+        for &slot in &self.order {
+            let chain = self.chains.at_mut(slot as usize).expect("live");
+            let anchor_world = match chain.params.anchor {
+                AnchorSource::ViewReference => k,
+                AnchorSource::Own => chain.anchor_pending,
+            };
+            let to_relative = |t: &Transform| Transform::new(t.position - origin, t.rotation);
+            let target = to_relative(&anchor_world);
+            let mut start = to_relative(&chain.anchor);
+            if !chain.placed {
+                chain.place(&target);
+                start = target;
+            } else if is_teleport(&start, &target, &settings) {
+                // Carry the chain rigidly: keeps its shape, adds no energy, no whip.
+                chain.state.carry(&target.mul(&start.inverse()));
+                start = target;
+            }
+            chain.anchor = anchor_world;
+            chain.update_rest(self.view);
+
+            let params = chain.params;
+            let alpha = params.alpha_per_iteration(h as f32, settings.iterations);
+            let decay = (-params.damping * h as f32).exp();
+            for s in 0..substeps {
+                let anchor = start.interpolate(&target, progress(s));
+                let input = SubstepInput {
+                    h: h as f32,
+                    anchor,
+                    gravity: settings.gravity * params.gravity_scale,
+                    velocity_decay: decay,
+                    alpha_per_iteration: alpha,
+                    iterations: settings.iterations,
+                    inv_mass: 1.0 / params.mass,
+                    orientation_weight: params.radius * params.radius / 5.0,
+                    rest: &chain.rest,
+                    previous_rest: chain.rest_changed.then_some(&chain.rest_used),
+                    momentum_suppression: params.momentum_suppression,
+                    half_kick: chain.half_kick,
+                };
+                if !substep(
+                    &mut chain.state,
+                    &chain.frame.lengths,
+                    &input,
+                    &mut self.scratch,
+                ) {
+                    fallbacks += 1;
+                }
+                chain.half_kick = false;
+                if chain.rest_changed {
+                    chain.rest_used.clone_from(&chain.rest);
+                    chain.rest_changed = false;
+                }
+                if s + 2 >= substeps {
+                    chain.capture_local(&anchor);
+                }
+            }
+            chain.write_output((after / h) as f32);
+        }
+        self.accumulator = after;
+        self.stats.substeps_last_step = substeps as u32;
+        self.stats.substeps_total += substeps;
+        self.stats.solver_fallbacks += fallbacks;
+        self.stats.time_dropped += dropped;
+        self.stats.simulated_time += simulated;
+        Ok(())
+    }
+
+    // ---- reading ------------------------------------------------------------------------------------
+
+    fn chains_in_order(&self) -> impl Iterator<Item = &Chain> {
+        self.order
+            .iter()
+            .map(|&slot| self.chains.at(slot as usize).expect("live"))
+    }
+
+    /// Chain ids in creation order (the order of batched reads and writes).
+    pub fn chain_ids(&self) -> impl Iterator<Item = ChainId> + '_ {
+        self.order
+            .iter()
+            .map(|&slot| self.chains.id_at(slot as usize).expect("live"))
+    }
+
+    /// World transforms of every joint of every chain, in creation order.
+    pub fn read_world(&self, out: &mut [Transform]) -> Result<usize> {
+        self.check_capacity(out.len())?;
+        let mut i = 0;
+        for chain in self.chains_in_order() {
+            for local in &chain.output {
+                out[i] = chain.anchor.mul(local);
+                i += 1;
+            }
+        }
+        Ok(i)
+    }
+
+    /// Each joint's rotation relative to its parent (joint 0: relative to the anchor), in creation order.
+    pub fn read_local_rotations(&self, out: &mut [Quat]) -> Result<usize> {
+        self.check_capacity(out.len())?;
+        let mut i = 0;
+        for chain in self.chains_in_order() {
+            let mut parent = Quat::IDENTITY;
+            for local in &chain.output {
+                out[i] = relative_rotation(parent, local.rotation);
+                parent = local.rotation;
+                i += 1;
+            }
+        }
+        Ok(i)
+    }
+
+    /// World transforms of one chain's joints.
+    pub fn read_chain_world(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
+        let chain = self.chain(id)?;
+        if out.len() < chain.joint_count() {
+            return Err(Error::invalid_argument(format!(
+                "buffer holds {} transforms, the chain has {}",
+                out.len(),
+                chain.joint_count()
+            )));
+        }
+        for (slot, local) in out.iter_mut().zip(&chain.output) {
+            *slot = chain.anchor.mul(local);
+        }
+        Ok(chain.joint_count())
+    }
+
+    /// The rest shape a chain is currently pulled towards (anchor frame).
+    pub fn chain_rest_shape(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
+        let chain = self.chain(id)?;
+        if out.len() < chain.joint_count() {
+            return Err(Error::invalid_argument(format!(
+                "buffer holds {} transforms, the chain has {}",
+                out.len(),
+                chain.joint_count()
+            )));
+        }
+        for (j, slot) in out.iter_mut().enumerate().take(chain.joint_count()) {
+            *slot = Transform::new(chain.rest.positions[j], chain.rest.orientations[j]);
+        }
+        Ok(chain.joint_count())
+    }
+
+    /// Kinetic energy of a chain's dynamic particles (J), from internal velocities.
+    pub fn chain_kinetic_energy(&self, id: ChainId) -> Result<f32> {
+        let chain = self.chain(id)?;
+        Ok(0.5
+            * chain.params.mass
+            * chain.state.v[1..]
+                .iter()
+                .map(|v| v.length_squared())
+                .sum::<f32>())
+    }
+
+    fn check_capacity(&self, capacity: usize) -> Result<()> {
+        if capacity < self.joint_count {
+            return Err(Error::invalid_argument(format!(
+                "buffer holds {capacity} entries, the engine has {} joints",
+                self.joint_count
+            )));
+        }
+        Ok(())
+    }
+
+    /// Hash of everything that determines future results: for determinism tests and for checking that a
+    /// rejected call left the engine bit-identical.
+    pub fn state_hash(&self) -> u64 {
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        let mut f = |x: f32| x.to_bits().hash(&mut hasher);
+        let s = &self.settings;
+        for x in [
+            s.gravity.x,
+            s.gravity.y,
+            s.gravity.z,
+            s.substep_rate,
+            s.time_scale,
+            s.teleport_distance,
+            s.teleport_angle,
+        ] {
+            f(x);
+        }
+        for x in [self.origin.x, self.origin.y, self.origin.z] {
+            f(x);
+        }
+        let mut words: Vec<u64> = vec![
+            self.accumulator.to_bits(),
+            s.max_substeps as u64,
+            s.iterations as u64,
+            self.order.len() as u64,
+        ];
+        for chain in self.chains_in_order() {
+            let p = &chain.params;
+            words.push(
+                chain.placed as u64
+                    | (chain.half_kick as u64) << 1
+                    | (chain.rest_changed as u64) << 2,
+            );
+            words.push(chain.views.len() as u64);
+            for view in &chain.views {
+                words.push(view.id.to_bits());
+                words.extend(
+                    [
+                        view.weighting.direction.x,
+                        view.weighting.direction.y,
+                        view.weighting.direction.z,
+                        view.weighting.influence,
+                    ]
+                    .map(|x| x.to_bits() as u64),
+                );
+                words.extend(
+                    view.encoded
+                        .bends
+                        .iter()
+                        .chain(&view.encoded.orientations)
+                        .flat_map(|q| q.to_array())
+                        .map(|x| x.to_bits() as u64),
+                );
+            }
+            words.extend(
+                [
+                    p.stiffness,
+                    p.damping,
+                    p.momentum_suppression,
+                    p.mass,
+                    p.radius,
+                    p.gravity_scale,
+                ]
+                .map(|x| x.to_bits() as u64),
+            );
+            let st = &chain.state;
+            let vecs =
+                st.x.iter()
+                    .chain(&st.v)
+                    .chain(&st.w)
+                    .chain(&chain.rest.positions);
+            words.extend(vecs.flat_map(|v| v.to_array()).map(|x| x.to_bits() as u64));
+            words.extend(chain.frame.lengths.iter().map(|x| x.to_bits() as u64));
+            let quats =
+                st.q.iter()
+                    .chain(&st.group_rotation)
+                    .chain(&chain.rest.orientations);
+            words.extend(quats.flat_map(|q| q.to_array()).map(|x| x.to_bits() as u64));
+            for t in [&chain.anchor, &chain.anchor_pending]
+                .into_iter()
+                .chain(&chain.output)
+                .chain(&chain.local_current)
+                .chain(&chain.local_previous)
+            {
+                words.extend(
+                    t.position
+                        .to_array()
+                        .into_iter()
+                        .chain(t.rotation.to_array())
+                        .map(|x| x.to_bits() as u64),
+                );
+            }
+        }
+        words.hash(&mut hasher);
+        hasher.finish()
+    }
+}
+
+fn is_teleport(from: &Transform, to: &Transform, settings: &EngineSettings) -> bool {
+    (to.position - from.position).length() > settings.teleport_distance
+        || rotation_angle(from.rotation.inverse() * to.rotation) > settings.teleport_angle
+}
+
+/// A transform from outside: finite, with a rotation that can be normalised.
+pub(crate) fn validate_transform(t: &Transform) -> Result<()> {
+    if !t.is_finite() {
+        return Err(Error::invalid_argument("non-finite position or rotation"));
+    }
+    let norm = t.rotation.length();
+    if !(norm > 1e-6 && norm.is_finite()) {
+        return Err(Error::invalid_argument("null rotation quaternion"));
+    }
+    Ok(())
+}
+
+fn validate_direction(d: Vec3) -> Result<Vec3> {
+    if !d.is_finite() {
+        return Err(Error::invalid_argument("view direction must be finite"));
+    }
+    direction(d).ok_or_else(|| Error::invalid_argument("view direction must not be zero"))
+}
+
+fn validate_influence(k: f32) -> Result<()> {
+    if k > 0.0 && k.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::invalid_argument(format!(
+            "influence must be finite and > 0, got {k}"
+        )))
+    }
+}

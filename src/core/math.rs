@@ -1,0 +1,164 @@
+//! Small math helpers on top of glam: rigid transforms and the quaternion operations the shape code needs.
+
+use glam::{Quat, Vec3};
+
+/// A rigid transform: rotate, then translate. Mirrors Unity's `Transform` (position + rotation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transform {
+    pub position: Vec3,
+    pub rotation: Quat,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self::IDENTITY
+    }
+}
+
+impl Transform {
+    pub const IDENTITY: Self = Self {
+        position: Vec3::ZERO,
+        rotation: Quat::IDENTITY,
+    };
+
+    #[inline]
+    pub fn new(position: Vec3, rotation: Quat) -> Self {
+        Self { position, rotation }
+    }
+
+    #[inline]
+    pub fn transform_point(&self, p: Vec3) -> Vec3 {
+        self.position + self.rotation * p
+    }
+
+    #[inline]
+    pub fn inverse_transform_point(&self, p: Vec3) -> Vec3 {
+        self.rotation.inverse() * (p - self.position)
+    }
+
+    /// `self * other`: apply `other` first, then `self`.
+    #[inline]
+    pub fn mul(&self, other: &Transform) -> Transform {
+        Transform {
+            position: self.transform_point(other.position),
+            rotation: self.rotation * other.rotation,
+        }
+    }
+
+    #[inline]
+    pub fn inverse(&self) -> Transform {
+        let inv = self.rotation.inverse();
+        Transform {
+            position: inv * -self.position,
+            rotation: inv,
+        }
+    }
+
+    /// Interpolation used for kinematic bones across substeps: lerp of positions, shorter-arc nlerp of
+    /// rotations (substeps are small, so nlerp's speed error is far below the solver's).
+    #[inline]
+    pub fn interpolate(&self, to: &Transform, t: f32) -> Transform {
+        Transform {
+            position: self.position.lerp(to.position, t),
+            rotation: nlerp_shorter(self.rotation, to.rotation, t),
+        }
+    }
+
+    pub fn is_finite(&self) -> bool {
+        self.position.is_finite() && self.rotation.is_finite()
+    }
+}
+
+/// `q` or `-q`, whichever lies in the same hemisphere as `reference` (they are the same rotation).
+#[inline]
+pub fn align_hemisphere(q: Quat, reference: Quat) -> Quat {
+    if q.dot(reference) < 0.0 { -q } else { q }
+}
+
+/// Normalised linear interpolation along the shorter arc.
+#[inline]
+pub fn nlerp_shorter(from: Quat, to: Quat, t: f32) -> Quat {
+    let to = align_hemisphere(to, from);
+    (from * (1.0 - t) + to * t).normalize()
+}
+
+/// The rotation with the smallest angle that turns `from` into `to` (both unit vectors). Antiparallel input
+/// turns about a fixed perpendicular axis, so encoding and decoding stay exact inverses there too.
+#[inline]
+pub fn shortest_arc(from: Vec3, to: Vec3) -> Quat {
+    Quat::from_rotation_arc(from, to)
+}
+
+/// Rotates `q` by the smallest swing that makes its local `axis` point along `direction` (unit), keeping
+/// the twist about that axis. This is what makes an output rotation skinning-ready.
+#[inline]
+pub fn swing_to(q: Quat, axis: Vec3, direction: Vec3) -> Quat {
+    let current = q * axis;
+    (shortest_arc(current, direction) * q).normalize()
+}
+
+/// Angle of the rotation `q` in radians, in [0, pi].
+#[inline]
+pub fn rotation_angle(q: Quat) -> f32 {
+    // atan2 keeps full precision for small angles, where acos(w) loses half the digits.
+    2.0 * q.xyz().length().atan2(q.w.abs())
+}
+
+/// Unit direction of `v`, or `None` when it is too short to have one.
+#[inline]
+pub fn direction(v: Vec3) -> Option<Vec3> {
+    let len = v.length();
+    if len > f32::MIN_POSITIVE.sqrt() && len.is_finite() {
+        Some(v / len)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transform_inverse_round_trips() {
+        let t = Transform::new(
+            Vec3::new(1.0, -2.0, 3.0),
+            Quat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0),
+        );
+        let p = Vec3::new(0.5, 0.25, -4.0);
+        let back = t.inverse().transform_point(t.transform_point(p));
+        assert!((back - p).length() < 1e-5);
+        assert!((t.inverse_transform_point(t.transform_point(p)) - p).length() < 1e-5);
+        let ident = t.mul(&t.inverse());
+        assert!(ident.position.length() < 1e-5);
+        assert!(rotation_angle(ident.rotation) < 1e-3);
+    }
+
+    #[test]
+    fn swing_keeps_twist_and_hits_direction() {
+        let twist = Quat::from_rotation_y(0.7);
+        let target = Vec3::new(1.0, 1.0, 0.0).normalize();
+        let q = swing_to(twist, Vec3::Y, target);
+        assert!((q * Vec3::Y - target).length() < 1e-6);
+        // Twist is preserved: the swing is the shortest arc, so the result's twist about the new axis
+        // equals the original twist about the old one.
+        let untwisted = swing_to(Quat::IDENTITY, Vec3::Y, target);
+        let relative = untwisted.inverse() * q;
+        assert!((rotation_angle(relative) - 0.7).abs() < 1e-5);
+        assert!((relative * Vec3::Y - Vec3::Y).length() < 1e-5);
+    }
+
+    #[test]
+    fn shortest_arc_antiparallel_is_exact() {
+        let q = shortest_arc(Vec3::Y, -Vec3::Y);
+        assert!((q * Vec3::Y + Vec3::Y).length() < 1e-6);
+    }
+
+    #[test]
+    fn nlerp_takes_shorter_arc() {
+        let a = Quat::from_rotation_z(0.1);
+        let b = -Quat::from_rotation_z(0.3);
+        let m = nlerp_shorter(a, b, 0.5);
+        assert!((rotation_angle(m) - 0.2).abs() < 1e-4);
+    }
+}

@@ -1,0 +1,28 @@
+//! The simulation core: plain safe Rust, no C types.
+//!
+//! - [`math`]: rigid transforms and quaternion helpers
+//! - [`shape`]: shapes and their encoded form (SPEC 3.1)
+//! - [`weights`]: view direction and blend weights (3.2)
+//! - [`blend`]: blending encoded shapes (3.3)
+//! - [`polar`], [`rod`], [`inextensible`]: the oriented-particle rod and its constraints (3.4)
+//! - [`params`]: settings, parameters, units
+//! - [`arena`], [`chain`], [`engine`]: objects, ids and the stepping loop (3.5, 3.6, 3.9)
+
+pub mod arena;
+pub mod blend;
+pub mod chain;
+pub mod engine;
+pub mod error;
+pub mod inextensible;
+pub mod math;
+pub mod params;
+pub mod polar;
+pub mod rod;
+pub mod shape;
+pub mod weights;
+
+pub use chain::ViewShapeId;
+pub use engine::{ChainId, Engine, Stats};
+pub use error::{Error, ErrorKind, Result};
+pub use math::Transform;
+pub use params::{AnchorSource, ChainParams, EngineSettings};

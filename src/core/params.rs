@@ -1,0 +1,249 @@
+//! Engine settings and chain parameters, their defaults, units and valid ranges.
+
+use glam::Vec3;
+
+use super::error::{Error, Result};
+
+/// Where a chain's anchor (the kinematic bone joint 0 is attached to) comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AnchorSource {
+    /// The view reference joint K given with every step (the default).
+    ViewReference,
+    /// The chain's own entry in the batched anchors.
+    Own,
+}
+
+/// Engine-wide settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EngineSettings {
+    /// World gravity, m/s².
+    pub gravity: Vec3,
+    /// Internal fixed steps per simulated second, Hz. Range [30, 10000].
+    pub substep_rate: f32,
+    /// Most internal steps one `step` call may run; time beyond is dropped and counted. Range [1, 1000].
+    pub max_substeps: u32,
+    /// Shape-matching + inextensibility passes per internal step. Range [1, 64].
+    pub iterations: u32,
+    /// Simulated seconds per real second; 0 pauses. Range [0, 100].
+    pub time_scale: f32,
+    /// An anchor moving farther than this in one call (m) is a teleport. > 0; `f32::MAX` disables.
+    pub teleport_distance: f32,
+    /// An anchor turning more than this in one call (radians) is a teleport. > 0; above pi disables.
+    pub teleport_angle: f32,
+}
+
+impl Default for EngineSettings {
+    fn default() -> Self {
+        Self {
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            substep_rate: 240.0,
+            max_substeps: 16,
+            iterations: 2,
+            time_scale: 1.0,
+            teleport_distance: 1.0,
+            teleport_angle: std::f32::consts::FRAC_PI_2,
+        }
+    }
+}
+
+fn check(ok: bool, message: impl FnOnce() -> String) -> Result<()> {
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::invalid_argument(message()))
+    }
+}
+
+impl EngineSettings {
+    pub fn validate(&self) -> Result<()> {
+        check(self.gravity.is_finite(), || "gravity must be finite".into())?;
+        check((30.0..=10000.0).contains(&self.substep_rate), || {
+            format!("substep_rate {} outside [30, 10000] Hz", self.substep_rate)
+        })?;
+        check((1..=1000).contains(&self.max_substeps), || {
+            format!("max_substeps {} outside [1, 1000]", self.max_substeps)
+        })?;
+        check((1..=64).contains(&self.iterations), || {
+            format!("iterations {} outside [1, 64]", self.iterations)
+        })?;
+        check((0.0..=100.0).contains(&self.time_scale), || {
+            format!("time_scale {} outside [0, 100]", self.time_scale)
+        })?;
+        check(
+            self.teleport_distance > 0.0 && self.teleport_distance.is_finite(),
+            || {
+                format!(
+                    "teleport_distance {} must be finite and > 0",
+                    self.teleport_distance
+                )
+            },
+        )?;
+        check(
+            self.teleport_angle > 0.0 && self.teleport_angle.is_finite(),
+            || {
+                format!(
+                    "teleport_angle {} must be finite and > 0",
+                    self.teleport_angle
+                )
+            },
+        )?;
+        Ok(())
+    }
+
+    pub fn substep(&self) -> f32 {
+        1.0 / self.substep_rate
+    }
+}
+
+/// Per-chain parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChainParams {
+    /// Pull towards the rest shape, dimensionless in [0, 1]: 0 is limp (an n-pendulum), 1 is rigid.
+    /// In between the rest shape acts like a spring of angular frequency `STIFFNESS_FREQUENCY * s / (1 - s)`
+    /// rad/s, independent of substep rate and iterations.
+    pub stiffness: f32,
+    /// Velocity damping per second, 1/s (velocity decays by `exp(-damping * t)`). Range [0, 1000].
+    pub damping: f32,
+    /// Share of the motion caused by a changing rest shape that is not turned into velocity, [0, 1].
+    pub momentum_suppression: f32,
+    /// Mass of each particle, kg. > 0. (Uniform masses: only matters once forces other than gravity act.)
+    pub mass: f32,
+    /// Particle radius, m (>= 0): weight of orientations in shape matching, later the collision radius.
+    pub radius: f32,
+    /// Multiplier on the engine's gravity, dimensionless. Range [-100, 100].
+    pub gravity_scale: f32,
+    pub anchor: AnchorSource,
+}
+
+/// Angular frequency (rad/s) of the rest-shape spring at stiffness 0.5.
+pub const STIFFNESS_FREQUENCY: f32 = 4.0 * std::f32::consts::PI;
+
+impl Default for ChainParams {
+    fn default() -> Self {
+        Self {
+            stiffness: 0.5,
+            damping: 1.0,
+            momentum_suppression: 1.0,
+            mass: 1.0,
+            radius: 0.02,
+            gravity_scale: 1.0,
+            anchor: AnchorSource::ViewReference,
+        }
+    }
+}
+
+impl ChainParams {
+    pub fn validate(&self) -> Result<()> {
+        check((0.0..=1.0).contains(&self.stiffness), || {
+            format!("stiffness {} outside [0, 1]", self.stiffness)
+        })?;
+        check((0.0..=1000.0).contains(&self.damping), || {
+            format!("damping {} outside [0, 1000] 1/s", self.damping)
+        })?;
+        check((0.0..=1.0).contains(&self.momentum_suppression), || {
+            format!(
+                "momentum_suppression {} outside [0, 1]",
+                self.momentum_suppression
+            )
+        })?;
+        check(self.mass > 0.0 && self.mass.is_finite(), || {
+            format!("mass {} must be finite and > 0", self.mass)
+        })?;
+        check(self.radius >= 0.0 && self.radius.is_finite(), || {
+            format!("radius {} must be finite and >= 0", self.radius)
+        })?;
+        check((-100.0..=100.0).contains(&self.gravity_scale), || {
+            format!("gravity_scale {} outside [-100, 100]", self.gravity_scale)
+        })?;
+        Ok(())
+    }
+
+    /// Fraction of the way to the goals per substep of length `h`: `1 - exp(-(omega h)^2)`, a spring of
+    /// frequency omega for small `omega h`, saturating at 1 (rigid) as the stiffness reaches 1.
+    pub fn alpha_per_substep(&self, h: f32) -> f32 {
+        if self.stiffness <= 0.0 {
+            return 0.0;
+        }
+        if self.stiffness >= 1.0 {
+            return 1.0;
+        }
+        let omega = STIFFNESS_FREQUENCY * self.stiffness / (1.0 - self.stiffness);
+        let x = omega * h;
+        -(-(x * x)).exp_m1()
+    }
+
+    /// The per-iteration fraction whose `iterations`-fold application equals the per-substep one.
+    pub fn alpha_per_iteration(&self, h: f32, iterations: u32) -> f32 {
+        let a = self.alpha_per_substep(h);
+        if a >= 1.0 || a <= 0.0 {
+            return a;
+        }
+        -((1.0 - a).ln() / iterations as f32).exp_m1()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid() {
+        EngineSettings::default().validate().unwrap();
+        ChainParams::default().validate().unwrap();
+    }
+
+    #[test]
+    fn alpha_limits_and_iteration_split() {
+        let p = |s| ChainParams {
+            stiffness: s,
+            ..Default::default()
+        };
+        assert_eq!(p(0.0).alpha_per_substep(1.0 / 240.0), 0.0);
+        assert_eq!(p(1.0).alpha_per_iteration(1.0 / 240.0, 4), 1.0);
+        let a = p(0.7).alpha_per_substep(1.0 / 240.0);
+        let a4 = p(0.7).alpha_per_iteration(1.0 / 240.0, 4);
+        assert!((1.0 - (1.0 - a4).powi(4) - a).abs() < 1e-6);
+        // Small-step limit: alpha / h^2 is the spring constant omega^2, independent of h.
+        let k1 = p(0.5).alpha_per_substep(1.0 / 240.0) * 240.0f32.powi(2);
+        let k2 = p(0.5).alpha_per_substep(1.0 / 960.0) * 960.0f32.powi(2);
+        assert!(
+            (k1 / k2 - 1.0).abs() < 0.01 && (k2 / STIFFNESS_FREQUENCY.powi(2) - 1.0).abs() < 0.01
+        );
+    }
+
+    #[test]
+    fn rejects_out_of_range() {
+        assert!(
+            ChainParams {
+                stiffness: f32::NAN,
+                ..Default::default()
+            }
+            .validate()
+            .is_err()
+        );
+        assert!(
+            ChainParams {
+                mass: 0.0,
+                ..Default::default()
+            }
+            .validate()
+            .is_err()
+        );
+        assert!(
+            EngineSettings {
+                iterations: 0,
+                ..Default::default()
+            }
+            .validate()
+            .is_err()
+        );
+        assert!(
+            EngineSettings {
+                gravity: Vec3::new(0.0, f32::INFINITY, 0.0),
+                ..Default::default()
+            }
+            .validate()
+            .is_err()
+        );
+    }
+}

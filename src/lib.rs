@@ -1,0 +1,14 @@
+//! kodawari: a view-dependent elastic-rod engine for the secondary motion of character joint chains.
+//!
+//! The artist gives, for a few view directions, how a chain (hair strand, ear, tail) should look from
+//! there; every step the engine blends those shapes by the current camera direction and uses the blend as
+//! the rest shape of an elastic rod that is simulated as usual.
+//!
+//! - [`core`]: the engine in plain safe Rust.
+//! - `ffi` (not public in Rust): the C ABI in `include/kodawari.h`, the only place with `extern "C"`.
+#![deny(unsafe_op_in_unsafe_fn)]
+
+pub mod core;
+mod ffi;
+
+pub use crate::core::*;

@@ -196,7 +196,10 @@ impl Engine {
 
     /// Anchors for the next step, one per chain in creation order (entries of chains anchored to the view
     /// reference are validated but unused).
-    pub fn set_anchors(&mut self, anchors: &[Transform]) -> Result<()> {
+    pub fn set_anchors<I>(&mut self, anchors: I) -> Result<()>
+    where
+        I: ExactSizeIterator<Item = Transform> + Clone,
+    {
         if anchors.len() != self.order.len() {
             return Err(Error::invalid_argument(format!(
                 "set_anchors needs one transform per chain ({}), got {}",
@@ -204,8 +207,8 @@ impl Engine {
                 anchors.len()
             )));
         }
-        for (i, anchor) in anchors.iter().enumerate() {
-            validate_transform(anchor)
+        for (i, anchor) in anchors.clone().enumerate() {
+            validate_transform(&anchor)
                 .map_err(|e| Error::invalid_argument(format!("anchor {i}: {e}")))?;
         }
         for (&slot, anchor) in self.order.iter().zip(anchors) {
@@ -463,31 +466,53 @@ impl Engine {
             .map(|&slot| self.chains.id_at(slot as usize).expect("live"))
     }
 
-    /// World transforms of every joint of every chain, in creation order.
-    pub fn read_world(&self, out: &mut [Transform]) -> Result<usize> {
-        self.check_capacity(out.len())?;
-        let mut i = 0;
+    /// Calls `f` with the world transform of every joint of every chain, in creation order; fails
+    /// without calling it when `capacity` is below the joint count.
+    pub fn for_each_world_transform(
+        &self,
+        capacity: usize,
+        mut f: impl FnMut(Transform),
+    ) -> Result<()> {
+        self.check_capacity(capacity)?;
         for chain in self.chains_in_order() {
             for local in &chain.output {
-                out[i] = chain.anchor.mul(local);
-                i += 1;
+                f(chain.anchor.mul(local));
             }
         }
-        Ok(i)
+        Ok(())
     }
 
-    /// Each joint's rotation relative to its parent (joint 0: relative to the anchor), in creation order.
-    pub fn read_local_rotations(&self, out: &mut [Quat]) -> Result<usize> {
-        self.check_capacity(out.len())?;
-        let mut i = 0;
+    /// Calls `f` with each joint's rotation relative to its parent (joint 0: relative to the anchor), in
+    /// the order of [`for_each_world_transform`](Self::for_each_world_transform).
+    pub fn for_each_local_rotation(&self, capacity: usize, mut f: impl FnMut(Quat)) -> Result<()> {
+        self.check_capacity(capacity)?;
         for chain in self.chains_in_order() {
             let mut parent = Quat::IDENTITY;
             for local in &chain.output {
-                out[i] = relative_rotation(parent, local.rotation);
+                f(relative_rotation(parent, local.rotation));
                 parent = local.rotation;
-                i += 1;
             }
         }
+        Ok(())
+    }
+
+    /// World transforms of every joint of every chain, in creation order. Returns how many were written.
+    pub fn read_world(&self, out: &mut [Transform]) -> Result<usize> {
+        let mut i = 0;
+        self.for_each_world_transform(out.len(), |t| {
+            out[i] = t;
+            i += 1;
+        })?;
+        Ok(i)
+    }
+
+    /// Local rotations (see [`for_each_local_rotation`](Self::for_each_local_rotation)) into `out`.
+    pub fn read_local_rotations(&self, out: &mut [Quat]) -> Result<usize> {
+        let mut i = 0;
+        self.for_each_local_rotation(out.len(), |q| {
+            out[i] = q;
+            i += 1;
+        })?;
         Ok(i)
     }
 
@@ -495,7 +520,7 @@ impl Engine {
     pub fn read_chain_world(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
         let chain = self.chain(id)?;
         if out.len() < chain.joint_count() {
-            return Err(Error::invalid_argument(format!(
+            return Err(Error::buffer_too_small(format!(
                 "buffer holds {} transforms, the chain has {}",
                 out.len(),
                 chain.joint_count()
@@ -511,7 +536,7 @@ impl Engine {
     pub fn chain_rest_shape(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
         let chain = self.chain(id)?;
         if out.len() < chain.joint_count() {
-            return Err(Error::invalid_argument(format!(
+            return Err(Error::buffer_too_small(format!(
                 "buffer holds {} transforms, the chain has {}",
                 out.len(),
                 chain.joint_count()
@@ -536,7 +561,7 @@ impl Engine {
 
     fn check_capacity(&self, capacity: usize) -> Result<()> {
         if capacity < self.joint_count {
-            return Err(Error::invalid_argument(format!(
+            return Err(Error::buffer_too_small(format!(
                 "buffer holds {capacity} entries, the engine has {} joints",
                 self.joint_count
             )));

@@ -10,6 +10,8 @@ pub enum ErrorKind {
     InvalidArgument,
     /// An arena ran out of id space.
     CapacityExceeded,
+    /// An output buffer is smaller than what must be written.
+    BufferTooSmall,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -29,6 +31,13 @@ impl Error {
     pub fn invalid_id(message: impl Into<String>) -> Self {
         Self {
             kind: ErrorKind::InvalidId,
+            message: message.into(),
+        }
+    }
+
+    pub fn buffer_too_small(message: impl Into<String>) -> Self {
+        Self {
+            kind: ErrorKind::BufferTooSmall,
             message: message.into(),
         }
     }

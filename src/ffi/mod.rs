@@ -1,1 +1,16 @@
+//! The C ABI: the only module with `extern "C"`, raw pointers and `catch_unwind`.
+//!
+//! - [`types`]: plain C structs (vectors, transforms, ids) and their conversions to core types
+//! - [`status`]: `kdw_status`, its strings, the thread-local error message
+//! - [`guard`]: the panic guard and the pointer checks every exported body goes through
+//! - one module per C concept: [`engine`], [`chain`], [`view_shape`], [`version`]
 
+#![allow(non_camel_case_types)] // C names, exactly as in the header.
+
+pub mod chain;
+pub mod engine;
+pub mod guard;
+pub mod status;
+pub mod types;
+pub mod version;
+pub mod view_shape;

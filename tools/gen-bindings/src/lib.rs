@@ -15,8 +15,9 @@ pub fn crate_dir() -> PathBuf {
 pub fn generate_header(crate_dir: &Path) -> String {
     let config =
         cbindgen::Config::from_file(crate_dir.join("cbindgen.toml")).expect("cbindgen.toml");
+    // Parse only src/ffi/: the core's public items are not part of the C API.
     let bindings = cbindgen::Builder::new()
-        .with_crate(crate_dir)
+        .with_src(crate_dir.join("src/ffi/mod.rs"))
         .with_config(config)
         .generate()
         .expect("cbindgen failed to generate the header");

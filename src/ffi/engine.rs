@@ -1,0 +1,305 @@
+//! `kdw_engine`: create, configure, step, read back.
+
+use glam::Quat;
+
+use super::guard::{
+    check_out, check_struct_size, destroy_handle, guard, into_handle, read, slice, slice_mut,
+    with_engine, with_engine_mut, write,
+};
+use super::status::kdw_status;
+use super::types::{
+    kdw_chain_id, kdw_engine_def, kdw_engine_stats, kdw_quat, kdw_transform, kdw_vec3,
+};
+use crate::core::{Engine, EngineSettings, Transform};
+
+/// One per character: owns chains and view shapes, gravity and solver settings. Opaque.
+pub struct kdw_engine {
+    _private: [u8; 0],
+}
+
+/// Default engine settings (240 Hz substeps, 2 iterations, gravity -9.81 on y, ...).
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_def_default() -> kdw_engine_def {
+    EngineSettings::default().into()
+}
+
+/// Creates an engine. `*out_engine` receives it; destroy it with `kdw_engine_destroy`.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_create(
+    def: *const kdw_engine_def,
+    out_engine: *mut *mut kdw_engine,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_engine, "out_engine")?;
+        // SAFETY: the caller passes a readable kdw_engine_def (NULL and alignment are checked).
+        let def = unsafe { read(def, "def") }?;
+        check_struct_size::<kdw_engine_def>(def.struct_size, "kdw_engine_def")?;
+        let engine = Engine::new(def.into())?;
+        // SAFETY: checked by check_out; the caller provides a writable pointer slot.
+        unsafe { write(out_engine, into_handle(engine)) };
+        Ok(())
+    })
+}
+
+/// Destroys an engine and everything it owns. Every id of it becomes invalid.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_destroy(engine: *mut kdw_engine) -> kdw_status {
+    // SAFETY: the caller passes a pointer from kdw_engine_create that it no longer uses afterwards.
+    guard(|| unsafe { destroy_handle(engine) })
+}
+
+/// Reads the engine's current settings.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_get_def(
+    engine: *const kdw_engine,
+    out_def: *mut kdw_engine_def,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_def, "out_def")?;
+        // SAFETY: `engine` is a live engine handle (caller contract).
+        let def: kdw_engine_def = unsafe { with_engine(engine, |e| Ok((*e.settings()).into())) }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_def, def) };
+        Ok(())
+    })
+}
+
+/// Replaces all settings at once (validated as a whole; nothing changes on error).
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_set_def(
+    engine: *mut kdw_engine,
+    def: *const kdw_engine_def,
+) -> kdw_status {
+    guard(|| {
+        // SAFETY: the caller passes a readable kdw_engine_def.
+        let def = unsafe { read(def, "def") }?;
+        check_struct_size::<kdw_engine_def>(def.struct_size, "kdw_engine_def")?;
+        // SAFETY: `engine` is a live engine handle used by this thread only.
+        unsafe { with_engine_mut(engine, |e| Ok(e.set_settings(def.into())?)) }
+    })
+}
+
+/// Sets world gravity, m/s².
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_set_gravity(
+    engine: *mut kdw_engine,
+    gravity: *const kdw_vec3,
+) -> kdw_status {
+    guard(|| {
+        // SAFETY: the caller passes a readable kdw_vec3.
+        let gravity = unsafe { read(gravity, "gravity") }?;
+        // SAFETY: live engine handle, this thread only.
+        unsafe { with_engine_mut(engine, |e| Ok(e.set_gravity((*gravity).into())?)) }
+    })
+}
+
+/// Advances every chain by `dt` seconds (scaled by the time scale) in fixed internal steps. `camera_position`
+/// and `view_reference` (the joint K the view direction is measured from; also the anchor of chains with
+/// `KDW_ANCHOR_VIEW_REFERENCE`) are in world space. `dt` must be finite and >= 0; `dt == 0` changes
+/// nothing.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_step(
+    engine: *mut kdw_engine,
+    dt: f32,
+    camera_position: *const kdw_vec3,
+    view_reference: *const kdw_transform,
+) -> kdw_status {
+    guard(|| {
+        // SAFETY: the caller passes readable structs.
+        let camera = unsafe { read(camera_position, "camera_position") }?;
+        // SAFETY: as above.
+        let k = unsafe { read(view_reference, "view_reference") }?;
+        // SAFETY: live engine handle, this thread only.
+        unsafe { with_engine_mut(engine, |e| Ok(e.step(dt, (*camera).into(), (*k).into())?)) }
+    })
+}
+
+/// Sets every chain's anchor for the next step: `count` must equal the chain count, entry i belongs to
+/// the i-th chain in creation order (entries of chains anchored to the view reference are checked but
+/// unused). World space. Interpolated across the substeps of the next step.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_set_anchors(
+    engine: *mut kdw_engine,
+    anchors: *const kdw_transform,
+    count: u32,
+) -> kdw_status {
+    guard(|| {
+        // SAFETY: the caller passes `count` readable transforms.
+        let anchors = unsafe { slice(anchors, count, "anchors") }?;
+        // SAFETY: live engine handle, this thread only.
+        unsafe {
+            with_engine_mut(engine, |e| {
+                Ok(e.set_anchors(anchors.iter().map(|t| Transform::from(*t)))?)
+            })
+        }
+    })
+}
+
+/// Number of chains.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_chain_count(
+    engine: *const kdw_engine,
+    out_count: *mut u32,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_count, "out_count")?;
+        // SAFETY: live engine handle.
+        let count = unsafe { with_engine(engine, |e| Ok(e.chain_count() as u32)) }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_count, count) };
+        Ok(())
+    })
+}
+
+/// Total number of joints of all chains: the size `kdw_engine_read_world` needs.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_joint_count(
+    engine: *const kdw_engine,
+    out_count: *mut u32,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_count, "out_count")?;
+        // SAFETY: live engine handle.
+        let count = unsafe { with_engine(engine, |e| Ok(e.joint_count() as u32)) }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_count, count) };
+        Ok(())
+    })
+}
+
+/// Chain ids in creation order (the order of every batched call). `capacity` must be at least the chain
+/// count; `*out_written` receives how many were written.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_get_chain_ids(
+    engine: *const kdw_engine,
+    out_ids: *mut kdw_chain_id,
+    capacity: u32,
+    out_written: *mut u32,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_written, "out_written")?;
+        // SAFETY: the caller passes `capacity` writable ids.
+        let out = unsafe { slice_mut(out_ids, capacity, "out_ids") }?;
+        // SAFETY: live engine handle.
+        let written = unsafe {
+            with_engine(engine, |e| {
+                if out.len() < e.chain_count() {
+                    return Err(crate::core::Error::buffer_too_small(format!(
+                        "buffer holds {} ids, the engine has {} chains",
+                        out.len(),
+                        e.chain_count()
+                    ))
+                    .into());
+                }
+                for (slot, id) in out.iter_mut().zip(e.chain_ids()) {
+                    *slot = id.to_bits();
+                }
+                Ok(e.chain_count() as u32)
+            })
+        }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_written, written) };
+        Ok(())
+    })
+}
+
+/// World transforms of every joint of every chain, chains in creation order, joints root to tip, at the
+/// render time of the last step (interpolated between internal steps). Rotations are skinning-ready: each
+/// joint's bone axis points at the next joint. `capacity` must be at least the joint count.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_read_world(
+    engine: *const kdw_engine,
+    out_transforms: *mut kdw_transform,
+    capacity: u32,
+    out_written: *mut u32,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_written, "out_written")?;
+        // SAFETY: the caller passes `capacity` writable transforms.
+        let out = unsafe { slice_mut(out_transforms, capacity, "out_transforms") }?;
+        // SAFETY: live engine handle.
+        let written = unsafe {
+            with_engine(engine, |e| {
+                let mut i = 0usize;
+                e.for_each_world_transform(out.len(), |t| {
+                    out[i] = t.into();
+                    i += 1;
+                })?;
+                Ok(i as u32)
+            })
+        }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_written, written) };
+        Ok(())
+    })
+}
+
+/// Each joint's rotation relative to its parent joint (joint 0: relative to its anchor), in the order of
+/// `kdw_engine_read_world`: what Unity writes to `Transform.localRotation`.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_read_local_rotations(
+    engine: *const kdw_engine,
+    out_rotations: *mut kdw_quat,
+    capacity: u32,
+    out_written: *mut u32,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_written, "out_written")?;
+        // SAFETY: the caller passes `capacity` writable quaternions.
+        let out = unsafe { slice_mut(out_rotations, capacity, "out_rotations") }?;
+        // SAFETY: live engine handle.
+        let written = unsafe {
+            with_engine(engine, |e| {
+                let mut i = 0usize;
+                e.for_each_local_rotation(out.len(), |q: Quat| {
+                    out[i] = q.into();
+                    i += 1;
+                })?;
+                Ok(i as u32)
+            })
+        }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_written, written) };
+        Ok(())
+    })
+}
+
+/// Counters: chains, joints, substeps run, time dropped, chains asleep.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_get_stats(
+    engine: *const kdw_engine,
+    out_stats: *mut kdw_engine_stats,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_stats, "out_stats")?;
+        // SAFETY: live engine handle.
+        let stats = unsafe { with_engine(engine, |e| Ok(e.stats())) }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_stats, stats.into()) };
+        Ok(())
+    })
+}
+
+/// Puts every chain back to its rest shape, at rest, at the next step.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_reset(engine: *mut kdw_engine) -> kdw_status {
+    // SAFETY: live engine handle, this thread only.
+    guard(|| unsafe { with_engine_mut(engine, |e| Ok(e.reset_all())) })
+}
+
+/// A hash of everything that determines future results. Equal hashes after equal calls show determinism;
+/// an unchanged hash after a rejected call shows the engine was left untouched.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_state_hash(
+    engine: *const kdw_engine,
+    out_hash: *mut u64,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_hash, "out_hash")?;
+        // SAFETY: live engine handle.
+        let hash = unsafe { with_engine(engine, |e| Ok(e.state_hash())) }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_hash, hash) };
+        Ok(())
+    })
+}

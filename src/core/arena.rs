@@ -56,10 +56,7 @@ impl<T> Id<T> {
     pub const NULL: Self = Self::from_bits(0);
 
     pub const fn from_bits(bits: u64) -> Self {
-        Self {
-            bits,
-            _kind: PhantomData,
-        }
+        Self { bits, _kind: PhantomData }
     }
 
     pub const fn to_bits(self) -> u64 {
@@ -90,12 +87,7 @@ pub struct Arena<T> {
 impl<T> Arena<T> {
     pub fn new(kind: Kind, salt: u16) -> Self {
         let tag = ((salt as u64) << SALT_SHIFT) | ((kind as u64 & KIND_MASK) << KIND_SHIFT);
-        Self {
-            slots: Vec::new(),
-            free: Vec::new(),
-            tag,
-            len: 0,
-        }
+        Self { slots: Vec::new(), free: Vec::new(), tag, len: 0 }
     }
 
     pub fn len(&self) -> usize {
@@ -121,10 +113,7 @@ impl<T> Arena<T> {
         let index = match self.free.pop() {
             Some(index) => index as usize,
             None if self.slots.len() < MAX_OBJECTS => {
-                self.slots.push(Slot {
-                    generation: 1,
-                    value: None,
-                });
+                self.slots.push(Slot { generation: 1, value: None });
                 self.slots.len() - 1
             }
             None => return None,
@@ -197,10 +186,7 @@ mod tests {
         assert!(a.get(id).is_none());
         let id2 = a.insert(6).unwrap();
         assert_eq!(a.index_of(id2), Some(0));
-        assert!(
-            a.get(id).is_none(),
-            "the old id must not reach the reused slot"
-        );
+        assert!(a.get(id).is_none(), "the old id must not reach the reused slot");
         assert_eq!(a.len(), 1);
     }
 }

@@ -11,26 +11,11 @@ pub fn blend_into<'a, I>(base: &EncodedShape, w0: f32, views: I, out: &mut Encod
 where
     I: Iterator<Item = (&'a EncodedShape, f32)> + Clone,
 {
-    blend_quats(
-        &base.bends,
-        w0,
-        views.clone().map(|(s, w)| (&s.bends[..], w)),
-        &mut out.bends,
-    );
-    blend_quats(
-        &base.orientations,
-        w0,
-        views.map(|(s, w)| (&s.orientations[..], w)),
-        &mut out.orientations,
-    );
+    blend_quats(&base.bends, w0, views.clone().map(|(s, w)| (&s.bends[..], w)), &mut out.bends);
+    blend_quats(&base.orientations, w0, views.map(|(s, w)| (&s.orientations[..], w)), &mut out.orientations);
 }
 
-fn blend_quats<'a>(
-    base: &[Quat],
-    w0: f32,
-    views: impl Iterator<Item = (&'a [Quat], f32)> + Clone,
-    out: &mut [Quat],
-) {
+fn blend_quats<'a>(base: &[Quat], w0: f32, views: impl Iterator<Item = (&'a [Quat], f32)> + Clone, out: &mut [Quat]) {
     for (j, (reference, slot)) in base.iter().zip(out.iter_mut()).enumerate() {
         let mut sum = *reference * w0;
         for (view, w) in views.clone() {
@@ -54,10 +39,7 @@ mod tests {
     use glam::Vec3;
 
     fn chain(points: &[Vec3], twist: f32) -> Shape {
-        let joints: Vec<Transform> = points
-            .iter()
-            .map(|p| Transform::new(*p, Quat::from_rotation_y(twist)))
-            .collect();
+        let joints: Vec<Transform> = points.iter().map(|p| Transform::new(*p, Quat::from_rotation_y(twist))).collect();
         Shape::from_joints(&joints).unwrap()
     }
 
@@ -66,10 +48,7 @@ mod tests {
         let base = chain(&[Vec3::ZERO, Vec3::Y, Vec3::new(0.0, 2.0, 0.0)], 0.0);
         let view = chain(&[Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0)], 0.5);
         let frame = ShapeFrame::from_base(&base);
-        let (eb, ev) = (
-            EncodedShape::encode(&base, frame.reference),
-            EncodedShape::encode(&view, frame.reference),
-        );
+        let (eb, ev) = (EncodedShape::encode(&base, frame.reference), EncodedShape::encode(&view, frame.reference));
         let mut out = EncodedShape::identity(3);
         blend_into(&eb, 0.0, [(&ev, 1.0)].into_iter(), &mut out);
         let decoded = out.decode(&frame);
@@ -86,10 +65,7 @@ mod tests {
         let base = chain(&[Vec3::ZERO, Vec3::Y, Vec3::new(0.0, 2.0, 0.0)], 0.0);
         let view = chain(&[Vec3::ZERO, Vec3::X, Vec3::new(2.0, 0.0, 0.0)], 0.0);
         let frame = ShapeFrame::from_base(&base);
-        let (eb, ev) = (
-            EncodedShape::encode(&base, frame.reference),
-            EncodedShape::encode(&view, frame.reference),
-        );
+        let (eb, ev) = (EncodedShape::encode(&base, frame.reference), EncodedShape::encode(&view, frame.reference));
         let mut out = EncodedShape::identity(3);
         blend_into(&eb, 0.5, [(&ev, 0.5)].into_iter(), &mut out);
         assert!((rotation_angle(out.bends[0]) - std::f32::consts::FRAC_PI_4).abs() < 1e-5);
@@ -100,15 +76,10 @@ mod tests {
     #[test]
     fn orbit_has_no_pops() {
         let n = 8;
-        let base_pts: Vec<Vec3> = (0..n)
-            .map(|i| Vec3::new(0.0, i as f32 * 0.1, 0.0))
-            .collect();
-        let left_pts: Vec<Vec3> = (0..n)
-            .map(|i| Vec3::new(-0.05 * i as f32, 0.08 * i as f32, 0.0))
-            .collect();
-        let right_pts: Vec<Vec3> = (0..n)
-            .map(|i| Vec3::new(0.05 * i as f32, 0.06 * i as f32, 0.02 * i as f32))
-            .collect();
+        let base_pts: Vec<Vec3> = (0..n).map(|i| Vec3::new(0.0, i as f32 * 0.1, 0.0)).collect();
+        let left_pts: Vec<Vec3> = (0..n).map(|i| Vec3::new(-0.05 * i as f32, 0.08 * i as f32, 0.0)).collect();
+        let right_pts: Vec<Vec3> =
+            (0..n).map(|i| Vec3::new(0.05 * i as f32, 0.06 * i as f32, 0.02 * i as f32)).collect();
         let base = chain(&base_pts, 0.0);
         let frame = ShapeFrame::from_base(&base);
         let eb = EncodedShape::encode(&base, frame.reference);
@@ -119,14 +90,8 @@ mod tests {
             *q = -*q;
         }
         let views = [
-            ViewWeighting {
-                direction: -Vec3::X,
-                influence: 1.0,
-            },
-            ViewWeighting {
-                direction: Vec3::X,
-                influence: 2.0,
-            },
+            ViewWeighting { direction: -Vec3::X, influence: 1.0 },
+            ViewWeighting { direction: Vec3::X, influence: 2.0 },
         ];
         let mut w = [0.0; 2];
         let mut out = EncodedShape::identity(n);
@@ -141,12 +106,7 @@ mod tests {
             let weights = [w0, w[0], w[1]];
             if let Some((pp, pq, pw)) = &previous {
                 let dw: f32 = weights.iter().zip(pw).map(|(a, b)| (a - b).abs()).sum();
-                let max_move = shape
-                    .positions
-                    .iter()
-                    .zip(pp)
-                    .map(|(a, b)| (*a - *b).length())
-                    .fold(0.0, f32::max);
+                let max_move = shape.positions.iter().zip(pp).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
                 let max_turn = shape
                     .orientations
                     .iter()
@@ -156,18 +116,9 @@ mod tests {
                 // A full swap between shapes (dw = 2) moves a joint at most ~2 chain lengths and turns it at
                 // most pi; a weight change dw moves it proportionally (factor 2 margin for the nonlinearity
                 // of normalisation). A pop would show as a jump with dw ~ 0.
-                assert!(
-                    max_move <= 2.0 * dw * chain_length + 1e-5,
-                    "deg {deg}: moved {max_move} for dw {dw}"
-                );
-                assert!(
-                    max_turn <= 2.0 * dw * std::f32::consts::PI + 2e-3,
-                    "deg {deg}: turned {max_turn} for dw {dw}"
-                );
-                assert!(
-                    max_move < 0.05 * chain_length,
-                    "deg {deg}: moved {max_move}"
-                );
+                assert!(max_move <= 2.0 * dw * chain_length + 1e-5, "deg {deg}: moved {max_move} for dw {dw}");
+                assert!(max_turn <= 2.0 * dw * std::f32::consts::PI + 2e-3, "deg {deg}: turned {max_turn} for dw {dw}");
+                assert!(max_move < 0.05 * chain_length, "deg {deg}: moved {max_move}");
             }
             previous = Some((shape.positions, shape.orientations, weights));
         }

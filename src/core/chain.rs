@@ -65,12 +65,8 @@ impl Chain {
         let n = base_shape.len();
         let frame = ShapeFrame::from_base(&base_shape);
         let base = EncodedShape::encode(&base_shape, frame.reference);
-        let local: Vec<Transform> = base_shape
-            .positions
-            .iter()
-            .zip(&base_shape.orientations)
-            .map(|(p, q)| Transform::new(*p, *q))
-            .collect();
+        let local: Vec<Transform> =
+            base_shape.positions.iter().zip(&base_shape.orientations).map(|(p, q)| Transform::new(*p, *q)).collect();
         let mut chain = Self {
             params,
             bone_axes: bone_axes(&base_shape),
@@ -133,8 +129,7 @@ impl Chain {
         let shape = Shape::from_joints(joints)?;
         let frame = ShapeFrame::from_base(&shape);
         for view in &mut self.views {
-            view.encoded
-                .rebase_reference(self.frame.reference, frame.reference);
+            view.encoded.rebase_reference(self.frame.reference, frame.reference);
         }
         self.base = EncodedShape::encode(&shape, frame.reference);
         self.bone_axes = bone_axes(&shape);
@@ -162,11 +157,7 @@ impl Chain {
             self.weights.resize(self.views.len(), 0.0);
             let weightings = self.views.iter().map(|v| v.weighting);
             let w0 = blend_weights(d, weightings, &mut self.weights);
-            let views = self
-                .views
-                .iter()
-                .zip(self.weights.iter())
-                .map(|(v, w)| (&v.encoded, *w));
+            let views = self.views.iter().zip(self.weights.iter()).map(|(v, w)| (&v.encoded, *w));
             blend_into(&self.base, w0, views, &mut self.blended);
         }
         let n = self.joint_count();
@@ -175,12 +166,11 @@ impl Chain {
         self.rest.positions = positions;
         for j in 0..n {
             let q = self.blended.orientations[j];
-            self.rest.orientations[j] = match (j + 1 < n)
-                .then(|| direction(self.rest.positions[j + 1] - self.rest.positions[j]))
-            {
-                Some(Some(dir)) => swing_to(q, self.bone_axes[j], dir),
-                _ => q,
-            };
+            self.rest.orientations[j] =
+                match (j + 1 < n).then(|| direction(self.rest.positions[j + 1] - self.rest.positions[j])) {
+                    Some(Some(dir)) => swing_to(q, self.bone_axes[j], dir),
+                    _ => q,
+                };
         }
         if self.rest != self.rest_used {
             self.rest_changed = true;
@@ -206,7 +196,7 @@ impl Chain {
         let inverse = anchor.inverse();
         for (j, local) in self.local_current.iter_mut().enumerate() {
             *local = Transform::new(
-                inverse.transform_point(self.state.x[j]),
+                anchor.inverse_transform_point_f64(self.state.x[j]),
                 (inverse.rotation * self.state.q[j]).normalize(),
             );
         }
@@ -218,10 +208,7 @@ impl Chain {
         let n = self.joint_count();
         for j in 0..n {
             let (a, b) = (&self.local_previous[j], &self.local_current[j]);
-            self.output[j] = Transform::new(
-                a.position.lerp(b.position, t),
-                nlerp_shorter(a.rotation, b.rotation, t),
-            );
+            self.output[j] = Transform::new(a.position.lerp(b.position, t), nlerp_shorter(a.rotation, b.rotation, t));
         }
         for j in 0..n - 1 {
             if let Some(dir) = direction(self.output[j + 1].position - self.output[j].position) {

@@ -11,7 +11,7 @@ use super::chain::{Chain, ViewShape, ViewShapeId, relative_rotation};
 use super::error::{Error, Result};
 use super::math::{Transform, direction, rotation_angle};
 use super::params::{AnchorSource, ChainParams, EngineSettings};
-use super::rod::{RodScratch, SubstepInput, substep};
+use super::rod::{RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
 
 pub type ChainId = Id<Chain>;
@@ -85,10 +85,7 @@ impl Engine {
     }
 
     pub fn set_gravity(&mut self, gravity: Vec3) -> Result<()> {
-        self.set_settings(EngineSettings {
-            gravity,
-            ..self.settings
-        })
+        self.set_settings(EngineSettings { gravity, ..self.settings })
     }
 
     pub fn chain_count(&self) -> usize {
@@ -100,46 +97,33 @@ impl Engine {
     }
 
     pub fn stats(&self) -> Stats {
-        Stats {
-            chain_count: self.order.len() as u32,
-            joint_count: self.joint_count as u32,
-            ..self.stats
-        }
+        Stats { chain_count: self.order.len() as u32, joint_count: self.joint_count as u32, ..self.stats }
     }
 
     // ---- chains -------------------------------------------------------------------------------------
 
     pub fn create_chain(&mut self, params: ChainParams, joints: &[Transform]) -> Result<ChainId> {
         if !self.chains.has_room() {
-            return Err(Error::capacity(
-                "the engine holds the maximum number of chains",
-            ));
+            return Err(Error::capacity("the engine holds the maximum number of chains"));
         }
         let chain = Chain::new(params, joints)?;
         let n = chain.joint_count();
         let id = self.chains.insert(chain).expect("room checked above");
-        self.order
-            .push(self.chains.index_of(id).expect("just inserted") as u32);
+        self.order.push(self.chains.index_of(id).expect("just inserted") as u32);
         self.joint_count += n;
         Ok(id)
     }
 
     fn chain(&self, id: ChainId) -> Result<&Chain> {
-        self.chains.get(id).ok_or_else(|| {
-            Error::invalid_id(format!(
-                "chain id {:#x} is null, stale or foreign",
-                id.to_bits()
-            ))
-        })
+        self.chains
+            .get(id)
+            .ok_or_else(|| Error::invalid_id(format!("chain id {:#x} is null, stale or foreign", id.to_bits())))
     }
 
     fn chain_mut(&mut self, id: ChainId) -> Result<&mut Chain> {
-        self.chains.get_mut(id).ok_or_else(|| {
-            Error::invalid_id(format!(
-                "chain id {:#x} is null, stale or foreign",
-                id.to_bits()
-            ))
-        })
+        self.chains
+            .get_mut(id)
+            .ok_or_else(|| Error::invalid_id(format!("chain id {:#x} is null, stale or foreign", id.to_bits())))
     }
 
     pub fn is_chain_valid(&self, id: ChainId) -> bool {
@@ -147,12 +131,10 @@ impl Engine {
     }
 
     pub fn destroy_chain(&mut self, id: ChainId) -> Result<()> {
-        let index = self.chains.index_of(id).ok_or_else(|| {
-            Error::invalid_id(format!(
-                "chain id {:#x} is null, stale or foreign",
-                id.to_bits()
-            ))
-        })?;
+        let index = self
+            .chains
+            .index_of(id)
+            .ok_or_else(|| Error::invalid_id(format!("chain id {:#x} is null, stale or foreign", id.to_bits())))?;
         let chain = self.chains.remove(id).expect("checked above");
         for view in &chain.views {
             self.view_shapes.remove(Id::from_bits(view.id.to_bits()));
@@ -208,14 +190,10 @@ impl Engine {
             )));
         }
         for (i, anchor) in anchors.clone().enumerate() {
-            validate_transform(&anchor)
-                .map_err(|e| Error::invalid_argument(format!("anchor {i}: {e}")))?;
+            validate_transform(&anchor).map_err(|e| Error::invalid_argument(format!("anchor {i}: {e}")))?;
         }
         for (&slot, anchor) in self.order.iter().zip(anchors) {
-            let chain = self
-                .chains
-                .at_mut(slot as usize)
-                .expect("order holds live chains");
+            let chain = self.chains.at_mut(slot as usize).expect("order holds live chains");
             chain.anchor_pending = Transform::new(anchor.position, anchor.rotation.normalize());
         }
         Ok(())
@@ -231,50 +209,25 @@ impl Engine {
         influence: f32,
     ) -> Result<ViewShapeId> {
         let slot = self.chains.index_of(chain_id).ok_or_else(|| {
-            Error::invalid_id(format!(
-                "chain id {:#x} is null, stale or foreign",
-                chain_id.to_bits()
-            ))
+            Error::invalid_id(format!("chain id {:#x} is null, stale or foreign", chain_id.to_bits()))
         })?;
         let direction = validate_direction(view_direction)?;
         validate_influence(influence)?;
         let chain = self.chains.at(slot).expect("checked");
         let encoded = chain.encode_view_shape(joints)?;
         if !self.view_shapes.has_room() {
-            return Err(Error::capacity(
-                "the engine holds the maximum number of view shapes",
-            ));
+            return Err(Error::capacity("the engine holds the maximum number of view shapes"));
         }
-        let id = Id::from_bits(
-            self.view_shapes
-                .insert(slot as u32)
-                .expect("room checked")
-                .to_bits(),
-        );
+        let id = Id::from_bits(self.view_shapes.insert(slot as u32).expect("room checked").to_bits());
         let chain = self.chains.at_mut(slot).expect("checked");
-        chain.views.push(ViewShape {
-            id,
-            weighting: ViewWeighting {
-                direction,
-                influence,
-            },
-            encoded,
-        });
+        chain.views.push(ViewShape { id, weighting: ViewWeighting { direction, influence }, encoded });
         chain.mark_shapes_dirty();
         Ok(id)
     }
 
     fn view_shape_mut(&mut self, id: ViewShapeId) -> Result<(&mut Chain, usize)> {
-        let err = || {
-            Error::invalid_id(format!(
-                "view shape id {:#x} is null, stale or foreign",
-                id.to_bits()
-            ))
-        };
-        let slot = *self
-            .view_shapes
-            .get(Id::from_bits(id.to_bits()))
-            .ok_or_else(err)?;
+        let err = || Error::invalid_id(format!("view shape id {:#x} is null, stale or foreign", id.to_bits()));
+        let slot = *self.view_shapes.get(Id::from_bits(id.to_bits())).ok_or_else(err)?;
         let chain = self.chains.at_mut(slot as usize).ok_or_else(err)?;
         let index = chain.view_shape_index(id).ok_or_else(err)?;
         Ok((chain, index))
@@ -288,11 +241,7 @@ impl Engine {
         Ok(())
     }
 
-    pub fn set_view_shape_direction(
-        &mut self,
-        id: ViewShapeId,
-        view_direction: Vec3,
-    ) -> Result<()> {
+    pub fn set_view_shape_direction(&mut self, id: ViewShapeId, view_direction: Vec3) -> Result<()> {
         let direction = validate_direction(view_direction)?;
         let (chain, index) = self.view_shape_mut(id)?;
         chain.views[index].weighting.direction = direction;
@@ -327,15 +276,12 @@ impl Engine {
     /// before anything changes; `dt == 0` changes nothing.
     pub fn step(&mut self, dt: f32, camera: Vec3, view_reference: Transform) -> Result<()> {
         if !(dt.is_finite() && dt >= 0.0) {
-            return Err(Error::invalid_argument(format!(
-                "dt must be finite and >= 0, got {dt}"
-            )));
+            return Err(Error::invalid_argument(format!("dt must be finite and >= 0, got {dt}")));
         }
         if !camera.is_finite() {
             return Err(Error::invalid_argument("camera position must be finite"));
         }
-        validate_transform(&view_reference)
-            .map_err(|e| Error::invalid_argument(format!("view reference: {e}")))?;
+        validate_transform(&view_reference).map_err(|e| Error::invalid_argument(format!("view reference: {e}")))?;
         if dt == 0.0 {
             return Ok(());
         }
@@ -346,11 +292,7 @@ impl Engine {
         let shift = self.origin - origin;
         if shift != Vec3::ZERO {
             for &slot in &self.order {
-                self.chains
-                    .at_mut(slot as usize)
-                    .expect("live")
-                    .state
-                    .translate(shift);
+                self.chains.at_mut(slot as usize).expect("live").state.translate(shift.as_dvec3());
             }
         }
         self.origin = origin;
@@ -376,11 +318,7 @@ impl Engine {
         // Fraction of this call's motion reached at the end of each substep, for anchor interpolation.
         let span = available - before;
         let progress = |s: u64| {
-            if span > 0.0 {
-                (((s + 1) as f64 * h - before) / span).clamp(0.0, 1.0) as f32
-            } else {
-                1.0
-            }
+            if span > 0.0 { (((s + 1) as f64 * h - before) / span).clamp(0.0, 1.0) as f32 } else { 1.0 }
         };
 
         let mut fallbacks = 0u64;
@@ -393,6 +331,7 @@ impl Engine {
             let to_relative = |t: &Transform| Transform::new(t.position - origin, t.rotation);
             let target = to_relative(&anchor_world);
             let mut start = to_relative(&chain.anchor);
+            chain.update_rest(self.view);
             if !chain.placed {
                 chain.place(&target);
                 start = target;
@@ -402,13 +341,27 @@ impl Engine {
                 start = target;
             }
             chain.anchor = anchor_world;
-            chain.update_rest(self.view);
 
             let params = chain.params;
             let alpha = params.alpha_per_iteration(h as f32, settings.iterations);
             let decay = (-params.damping * h as f32).exp();
+            let suppression_share = params.momentum_suppression * params.alpha_per_substep(h as f32);
             for s in 0..substeps {
                 let anchor = start.interpolate(&target, progress(s));
+                if chain.rest_changed {
+                    if suppression_share > 0.0 {
+                        carry_to_new_rest(
+                            &mut chain.state,
+                            &anchor,
+                            &chain.rest_used,
+                            &chain.rest,
+                            suppression_share,
+                            &mut self.scratch,
+                        );
+                    }
+                    chain.rest_used.clone_from(&chain.rest);
+                    chain.rest_changed = false;
+                }
                 let input = SubstepInput {
                     h: h as f32,
                     anchor,
@@ -419,23 +372,12 @@ impl Engine {
                     inv_mass: 1.0 / params.mass,
                     orientation_weight: params.radius * params.radius / 5.0,
                     rest: &chain.rest,
-                    previous_rest: chain.rest_changed.then_some(&chain.rest_used),
-                    momentum_suppression: params.momentum_suppression,
                     half_kick: chain.half_kick,
                 };
-                if !substep(
-                    &mut chain.state,
-                    &chain.frame.lengths,
-                    &input,
-                    &mut self.scratch,
-                ) {
+                if !substep(&mut chain.state, &chain.frame.lengths, &input, &mut self.scratch) {
                     fallbacks += 1;
                 }
                 chain.half_kick = false;
-                if chain.rest_changed {
-                    chain.rest_used.clone_from(&chain.rest);
-                    chain.rest_changed = false;
-                }
                 if s + 2 >= substeps {
                     chain.capture_local(&anchor);
                 }
@@ -454,25 +396,17 @@ impl Engine {
     // ---- reading ------------------------------------------------------------------------------------
 
     fn chains_in_order(&self) -> impl Iterator<Item = &Chain> {
-        self.order
-            .iter()
-            .map(|&slot| self.chains.at(slot as usize).expect("live"))
+        self.order.iter().map(|&slot| self.chains.at(slot as usize).expect("live"))
     }
 
     /// Chain ids in creation order (the order of batched reads and writes).
     pub fn chain_ids(&self) -> impl Iterator<Item = ChainId> + '_ {
-        self.order
-            .iter()
-            .map(|&slot| self.chains.id_at(slot as usize).expect("live"))
+        self.order.iter().map(|&slot| self.chains.id_at(slot as usize).expect("live"))
     }
 
     /// Calls `f` with the world transform of every joint of every chain, in creation order; fails
     /// without calling it when `capacity` is below the joint count.
-    pub fn for_each_world_transform(
-        &self,
-        capacity: usize,
-        mut f: impl FnMut(Transform),
-    ) -> Result<()> {
+    pub fn for_each_world_transform(&self, capacity: usize, mut f: impl FnMut(Transform)) -> Result<()> {
         self.check_capacity(capacity)?;
         for chain in self.chains_in_order() {
             for local in &chain.output {
@@ -551,12 +485,7 @@ impl Engine {
     /// Kinetic energy of a chain's dynamic particles (J), from internal velocities.
     pub fn chain_kinetic_energy(&self, id: ChainId) -> Result<f32> {
         let chain = self.chain(id)?;
-        Ok(0.5
-            * chain.params.mass
-            * chain.state.v[1..]
-                .iter()
-                .map(|v| v.length_squared())
-                .sum::<f32>())
+        Ok(0.5 * chain.params.mass * chain.state.v[1..].iter().map(|v| v.length_squared()).sum::<f32>())
     }
 
     fn check_capacity(&self, capacity: usize) -> Result<()> {
@@ -575,33 +504,19 @@ impl Engine {
         let mut hasher = std::collections::hash_map::DefaultHasher::new();
         let mut f = |x: f32| x.to_bits().hash(&mut hasher);
         let s = &self.settings;
-        for x in [
-            s.gravity.x,
-            s.gravity.y,
-            s.gravity.z,
-            s.substep_rate,
-            s.time_scale,
-            s.teleport_distance,
-            s.teleport_angle,
-        ] {
+        for x in
+            [s.gravity.x, s.gravity.y, s.gravity.z, s.substep_rate, s.time_scale, s.teleport_distance, s.teleport_angle]
+        {
             f(x);
         }
         for x in [self.origin.x, self.origin.y, self.origin.z] {
             f(x);
         }
-        let mut words: Vec<u64> = vec![
-            self.accumulator.to_bits(),
-            s.max_substeps as u64,
-            s.iterations as u64,
-            self.order.len() as u64,
-        ];
+        let mut words: Vec<u64> =
+            vec![self.accumulator.to_bits(), s.max_substeps as u64, s.iterations as u64, self.order.len() as u64];
         for chain in self.chains_in_order() {
             let p = &chain.params;
-            words.push(
-                chain.placed as u64
-                    | (chain.half_kick as u64) << 1
-                    | (chain.rest_changed as u64) << 2,
-            );
+            words.push(chain.placed as u64 | (chain.half_kick as u64) << 1 | (chain.rest_changed as u64) << 2);
             words.push(chain.views.len() as u64);
             for view in &chain.views {
                 words.push(view.id.to_bits());
@@ -624,28 +539,15 @@ impl Engine {
                 );
             }
             words.extend(
-                [
-                    p.stiffness,
-                    p.damping,
-                    p.momentum_suppression,
-                    p.mass,
-                    p.radius,
-                    p.gravity_scale,
-                ]
-                .map(|x| x.to_bits() as u64),
+                [p.stiffness, p.damping, p.momentum_suppression, p.mass, p.radius, p.gravity_scale]
+                    .map(|x| x.to_bits() as u64),
             );
             let st = &chain.state;
-            let vecs =
-                st.x.iter()
-                    .chain(&st.v)
-                    .chain(&st.w)
-                    .chain(&chain.rest.positions);
+            words.extend(st.x.iter().flat_map(|v| v.to_array()).map(f64::to_bits));
+            let vecs = st.v.iter().chain(&st.w).chain(&chain.rest.positions);
             words.extend(vecs.flat_map(|v| v.to_array()).map(|x| x.to_bits() as u64));
             words.extend(chain.frame.lengths.iter().map(|x| x.to_bits() as u64));
-            let quats =
-                st.q.iter()
-                    .chain(&st.group_rotation)
-                    .chain(&chain.rest.orientations);
+            let quats = st.q.iter().chain(&st.group_rotation).chain(&chain.rest.orientations);
             words.extend(quats.flat_map(|q| q.to_array()).map(|x| x.to_bits() as u64));
             for t in [&chain.anchor, &chain.anchor_pending]
                 .into_iter()
@@ -653,13 +555,8 @@ impl Engine {
                 .chain(&chain.local_current)
                 .chain(&chain.local_previous)
             {
-                words.extend(
-                    t.position
-                        .to_array()
-                        .into_iter()
-                        .chain(t.rotation.to_array())
-                        .map(|x| x.to_bits() as u64),
-                );
+                words
+                    .extend(t.position.to_array().into_iter().chain(t.rotation.to_array()).map(|x| x.to_bits() as u64));
             }
         }
         words.hash(&mut hasher);
@@ -695,8 +592,6 @@ fn validate_influence(k: f32) -> Result<()> {
     if k > 0.0 && k.is_finite() {
         Ok(())
     } else {
-        Err(Error::invalid_argument(format!(
-            "influence must be finite and > 0, got {k}"
-        )))
+        Err(Error::invalid_argument(format!("influence must be finite and > 0, got {k}")))
     }
 }

@@ -22,31 +22,19 @@ pub struct Error {
 
 impl Error {
     pub fn invalid_argument(message: impl Into<String>) -> Self {
-        Self {
-            kind: ErrorKind::InvalidArgument,
-            message: message.into(),
-        }
+        Self { kind: ErrorKind::InvalidArgument, message: message.into() }
     }
 
     pub fn invalid_id(message: impl Into<String>) -> Self {
-        Self {
-            kind: ErrorKind::InvalidId,
-            message: message.into(),
-        }
+        Self { kind: ErrorKind::InvalidId, message: message.into() }
     }
 
     pub fn buffer_too_small(message: impl Into<String>) -> Self {
-        Self {
-            kind: ErrorKind::BufferTooSmall,
-            message: message.into(),
-        }
+        Self { kind: ErrorKind::BufferTooSmall, message: message.into() }
     }
 
     pub fn capacity(message: impl Into<String>) -> Self {
-        Self {
-            kind: ErrorKind::CapacityExceeded,
-            message: message.into(),
-        }
+        Self { kind: ErrorKind::CapacityExceeded, message: message.into() }
     }
 }
 

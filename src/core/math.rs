@@ -1,6 +1,6 @@
 //! Small math helpers on top of glam: rigid transforms and the quaternion operations the shape code needs.
 
-use glam::{Quat, Vec3};
+use glam::{DVec3, Quat, Vec3};
 
 /// A rigid transform: rotate, then translate. Mirrors Unity's `Transform` (position + rotation).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,10 +16,7 @@ impl Default for Transform {
 }
 
 impl Transform {
-    pub const IDENTITY: Self = Self {
-        position: Vec3::ZERO,
-        rotation: Quat::IDENTITY,
-    };
+    pub const IDENTITY: Self = Self { position: Vec3::ZERO, rotation: Quat::IDENTITY };
 
     #[inline]
     pub fn new(position: Vec3, rotation: Quat) -> Self {
@@ -36,22 +33,34 @@ impl Transform {
         self.rotation.inverse() * (p - self.position)
     }
 
+    /// `transform_point` for double-precision particle positions.
+    #[inline]
+    pub fn transform_point_f64(&self, p: DVec3) -> DVec3 {
+        self.position.as_dvec3() + self.rotation.as_dquat() * p
+    }
+
+    /// A local offset (single precision) placed under this transform, in double precision.
+    #[inline]
+    pub fn place_f64(&self, local: Vec3) -> DVec3 {
+        self.position.as_dvec3() + (self.rotation * local).as_dvec3()
+    }
+
+    /// `inverse_transform_point` for a double-precision position whose local result is small.
+    #[inline]
+    pub fn inverse_transform_point_f64(&self, p: DVec3) -> Vec3 {
+        self.rotation.inverse() * (p - self.position.as_dvec3()).as_vec3()
+    }
+
     /// `self * other`: apply `other` first, then `self`.
     #[inline]
     pub fn mul(&self, other: &Transform) -> Transform {
-        Transform {
-            position: self.transform_point(other.position),
-            rotation: self.rotation * other.rotation,
-        }
+        Transform { position: self.transform_point(other.position), rotation: self.rotation * other.rotation }
     }
 
     #[inline]
     pub fn inverse(&self) -> Transform {
         let inv = self.rotation.inverse();
-        Transform {
-            position: inv * -self.position,
-            rotation: inv,
-        }
+        Transform { position: inv * -self.position, rotation: inv }
     }
 
     /// Interpolation used for kinematic bones across substeps: lerp of positions, shorter-arc nlerp of
@@ -84,9 +93,11 @@ pub fn nlerp_shorter(from: Quat, to: Quat, t: f32) -> Quat {
 
 /// The rotation with the smallest angle that turns `from` into `to` (both unit vectors). Antiparallel input
 /// turns about a fixed perpendicular axis, so encoding and decoding stay exact inverses there too.
+/// Computed in double precision: near a 180-degree fold the `1 + cos` term cancels, and in float32 the
+/// arc would miss `to` by up to 1e-4.
 #[inline]
 pub fn shortest_arc(from: Vec3, to: Vec3) -> Quat {
-    Quat::from_rotation_arc(from, to)
+    glam::DQuat::from_rotation_arc(from.as_dvec3().normalize(), to.as_dvec3().normalize()).as_quat()
 }
 
 /// Rotates `q` by the smallest swing that makes its local `axis` point along `direction` (unit), keeping
@@ -108,11 +119,7 @@ pub fn rotation_angle(q: Quat) -> f32 {
 #[inline]
 pub fn direction(v: Vec3) -> Option<Vec3> {
     let len = v.length();
-    if len > f32::MIN_POSITIVE.sqrt() && len.is_finite() {
-        Some(v / len)
-    } else {
-        None
-    }
+    if len > f32::MIN_POSITIVE.sqrt() && len.is_finite() { Some(v / len) } else { None }
 }
 
 #[cfg(test)]
@@ -121,10 +128,7 @@ mod tests {
 
     #[test]
     fn transform_inverse_round_trips() {
-        let t = Transform::new(
-            Vec3::new(1.0, -2.0, 3.0),
-            Quat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0),
-        );
+        let t = Transform::new(Vec3::new(1.0, -2.0, 3.0), Quat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0));
         let p = Vec3::new(0.5, 0.25, -4.0);
         let back = t.inverse().transform_point(t.transform_point(p));
         assert!((back - p).length() < 1e-5);

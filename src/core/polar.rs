@@ -13,10 +13,8 @@ const CONVERGED_ANGLE: f32 = 1e-7;
 pub fn extract_rotation(a: &Mat3, q: &mut Quat, max_iterations: u32) {
     for _ in 0..max_iterations {
         let r = Mat3::from_quat(*q);
-        let omega_num =
-            r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
-        let omega_den =
-            (r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis)).abs() + 1e-9;
+        let omega_num = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
+        let omega_den = (r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis)).abs() + 1e-9;
         let omega = omega_num / omega_den;
         let angle = omega.length();
         if angle < CONVERGED_ANGLE {

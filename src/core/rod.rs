@@ -2,7 +2,7 @@
 //! inextensible by [`inextensible`](super::inextensible). This module advances one chain by one internal
 //! substep; the engine decides when and with which kinematic input.
 
-use glam::{Mat3, Quat, Vec3};
+use glam::{DVec3, Mat3, Quat, Vec3};
 
 use super::inextensible::{self, ConstraintScratch};
 use super::math::{Transform, align_hemisphere, nlerp_shorter};
@@ -14,9 +14,13 @@ use super::shape::Shape;
 const POLAR_ITERATIONS: u32 = 8;
 
 /// The dynamic state of a chain's particles, relative to the engine's origin. Particle 0 is kinematic.
+///
+/// Positions are double precision: a soft chain's per-substep pull towards its rest shape is a small
+/// fraction of a small error, and in float32 it rounds away (the chain stalls short of its rest shape by
+/// an amount inversely proportional to the stiffness). Everything else is single precision.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RodState {
-    pub x: Vec<Vec3>,
+    pub x: Vec<DVec3>,
     pub v: Vec<Vec3>,
     pub q: Vec<Quat>,
     pub w: Vec<Vec3>,
@@ -29,7 +33,7 @@ impl RodState {
     pub fn at_rest(rest: &Shape, anchor: &Transform) -> Self {
         let n = rest.len();
         let mut s = Self {
-            x: vec![Vec3::ZERO; n],
+            x: vec![DVec3::ZERO; n],
             v: vec![Vec3::ZERO; n],
             q: vec![Quat::IDENTITY; n],
             w: vec![Vec3::ZERO; n],
@@ -41,7 +45,7 @@ impl RodState {
 
     pub fn place_at_rest(&mut self, rest: &Shape, anchor: &Transform) {
         for j in 0..rest.len() {
-            self.x[j] = anchor.transform_point(rest.positions[j]);
+            self.x[j] = anchor.place_f64(rest.positions[j]);
             self.q[j] = (anchor.rotation * rest.orientations[j]).normalize();
         }
         self.v.fill(Vec3::ZERO);
@@ -53,7 +57,7 @@ impl RodState {
     /// with it, so no kinetic energy is added.
     pub fn carry(&mut self, delta: &Transform) {
         for x in &mut self.x {
-            *x = delta.transform_point(*x);
+            *x = delta.transform_point_f64(*x);
         }
         for v in self.v.iter_mut().chain(self.w.iter_mut()) {
             *v = delta.rotation * *v;
@@ -63,18 +67,15 @@ impl RodState {
         }
     }
 
-    pub fn translate(&mut self, offset: Vec3) {
+    pub fn translate(&mut self, offset: DVec3) {
         for x in &mut self.x {
             *x += offset;
         }
     }
 
     pub fn is_finite(&self) -> bool {
-        self.x
-            .iter()
-            .chain(&self.v)
-            .chain(&self.w)
-            .all(|v| v.is_finite())
+        self.x.iter().all(|x| x.is_finite())
+            && self.v.iter().chain(&self.w).all(|v| v.is_finite())
             && self.q.iter().all(|q| q.is_finite())
     }
 }
@@ -94,9 +95,6 @@ pub struct SubstepInput<'a> {
     /// `a^2 / 5`: weight of particle orientations in the group matrix.
     pub orientation_weight: f32,
     pub rest: &'a Shape,
-    /// The rest shape of the previous substep when it differs from `rest` (momentum suppression).
-    pub previous_rest: Option<&'a Shape>,
-    pub momentum_suppression: f32,
     /// First substep after placement: a half gravity kick starts the leapfrog.
     pub half_kick: bool,
 }
@@ -104,47 +102,34 @@ pub struct SubstepInput<'a> {
 /// Per-particle buffers reused across chains and substeps.
 #[derive(Default)]
 pub struct RodScratch {
-    p: Vec<Vec3>,
+    p: Vec<DVec3>,
     qp: Vec<Quat>,
-    /// Displacement caused by the rest shape's own change: moved, but not turned into velocity.
-    suppressed: Vec<Vec3>,
-    suppressed_turn: Vec<Vec3>,
+    /// Positions of the chain carried over to a new rest shape (momentum suppression).
+    p_old: Vec<DVec3>,
     constraints: ConstraintScratch,
 }
 
 impl RodScratch {
     fn reserve(&mut self, n: usize) {
         if self.p.len() < n {
-            self.p.resize(n, Vec3::ZERO);
+            self.p.resize(n, DVec3::ZERO);
             self.qp.resize(n, Quat::IDENTITY);
-            self.suppressed.resize(n, Vec3::ZERO);
-            self.suppressed_turn.resize(n, Vec3::ZERO);
+            self.p_old.resize(n, DVec3::ZERO);
         }
         self.constraints.reserve(n.saturating_sub(1));
     }
 }
 
 /// Advances one chain by one substep. Returns `false` if the inextensibility solve had to fall back.
-pub fn substep(
-    state: &mut RodState,
-    lengths: &[f32],
-    input: &SubstepInput<'_>,
-    scratch: &mut RodScratch,
-) -> bool {
+pub fn substep(state: &mut RodState, lengths: &[f32], input: &SubstepInput<'_>, scratch: &mut RodScratch) -> bool {
     let n = state.x.len();
     scratch.reserve(n);
     let h = input.h;
-    let RodScratch {
-        p,
-        qp,
-        suppressed,
-        suppressed_turn,
-        constraints,
-    } = scratch;
+    let RodScratch { p, qp, constraints, .. } = scratch;
     let (p, qp) = (&mut p[..n], &mut qp[..n]);
 
     // Kinematic root.
-    p[0] = input.anchor.transform_point(input.rest.positions[0]);
+    p[0] = input.anchor.place_f64(input.rest.positions[0]);
     qp[0] = (input.anchor.rotation * input.rest.orientations[0]).normalize();
 
     // Predict the dynamic particles.
@@ -152,52 +137,25 @@ pub fn substep(
     for i in 1..n {
         state.v[i] = state.v[i] * input.velocity_decay + input.gravity * kick;
         state.w[i] *= input.velocity_decay;
-        p[i] = state.x[i] + state.v[i] * h;
+        p[i] = state.x[i] + (state.v[i] * h).as_dvec3();
         qp[i] = (Quat::from_scaled_axis(state.w[i] * h) * state.q[i]).normalize();
     }
 
-    let suppress = input.previous_rest.is_some() && input.momentum_suppression > 0.0;
-    if suppress {
-        suppressed[..n].fill(Vec3::ZERO);
-        suppressed_turn[..n].fill(Vec3::ZERO);
-    }
     let alpha = input.alpha_per_iteration;
-    let iterations = if alpha > 0.0 {
-        input.iterations.max(1)
-    } else {
-        1
-    };
+    let iterations = if alpha > 0.0 { input.iterations.max(1) } else { 1 };
     let mut direct = true;
-    for iteration in 0..iterations {
+    for _ in 0..iterations {
         if alpha > 0.0 {
-            // Share of this pass's rest-change displacement that survives the later passes, so that the
-            // suppressed total equals what the rest change actually caused.
-            let survive = (1.0 - alpha).powi((iterations - 1 - iteration) as i32);
-            match_shape(
-                state,
-                p,
-                qp,
-                input,
-                alpha,
-                survive,
-                suppress.then_some((&mut suppressed[..n], &mut suppressed_turn[..n])),
-            );
+            match_shape(&mut state.group_rotation, p, qp, input.rest, input.orientation_weight, alpha);
         }
         direct &= inextensible::solve(&state.x, p, lengths, input.inv_mass, constraints);
     }
 
-    // Velocities from positions, minus what the rest change moved.
+    // Velocities from positions.
     let inv_h = 1.0 / h;
     for i in 1..n {
-        let mut displacement = p[i] - state.x[i];
-        let mut turn =
-            align_hemisphere(qp[i] * state.q[i].inverse(), Quat::IDENTITY).to_scaled_axis();
-        if suppress {
-            displacement -= suppressed[i] * input.momentum_suppression;
-            turn -= suppressed_turn[i] * input.momentum_suppression;
-        }
-        state.v[i] = displacement * inv_h;
-        state.w[i] = turn * inv_h;
+        state.v[i] = (p[i] - state.x[i]).as_vec3() * inv_h;
+        state.w[i] = align_hemisphere(qp[i] * state.q[i].inverse(), Quat::IDENTITY).to_scaled_axis() * inv_h;
         state.x[i] = p[i];
         state.q[i] = qp[i];
     }
@@ -206,55 +164,83 @@ pub fn substep(
     direct
 }
 
-/// One Gauss-Seidel pass over the shape-matching groups `{i-1, i, i+1}`, root to tip.
-fn match_shape(
+/// Momentum suppression (SPEC 3.6): the rest shape changed from `old` to `new` since the last substep.
+/// Instead of letting the shape-matching goals jump (which the position-based update would turn into
+/// velocity), the share of the change that the chain's stiffness realises in one substep is applied to
+/// the positions directly: every segment keeps its current rotation relative to its rest segment, so the
+/// chain's own deformation (and its velocity) is carried over to the new rest shape with exact lengths.
+/// At stiffness 1 the chain lands on the new rest shape; a soft chain still lags behind it naturally.
+pub fn carry_to_new_rest(
     state: &mut RodState,
-    p: &mut [Vec3],
+    anchor: &Transform,
+    old: &Shape,
+    new: &Shape,
+    share: f32,
+    scratch: &mut RodScratch,
+) {
+    let n = state.x.len();
+    scratch.reserve(n);
+    let target = &mut scratch.p_old[..n];
+    target[0] = state.x[0];
+    for k in 0..n - 1 {
+        let old_segment = anchor.rotation * (old.positions[k + 1] - old.positions[k]);
+        let current = (state.x[k + 1] - state.x[k]).as_vec3();
+        let deformation = match (super::math::direction(old_segment), super::math::direction(current)) {
+            (Some(from), Some(to)) => super::math::shortest_arc(from, to),
+            _ => anchor.rotation,
+        };
+        let new_segment = anchor.rotation * (new.positions[k + 1] - new.positions[k]);
+        target[k + 1] = target[k] + (deformation * new_segment).as_dvec3();
+    }
+    let share_f64 = share as f64;
+    for j in 1..n {
+        let x = state.x[j];
+        state.x[j] = x + (target[j] - x) * share_f64;
+        let carried = (state.q[j] * old.orientations[j].inverse() * new.orientations[j]).normalize();
+        state.q[j] = nlerp_shorter(state.q[j], carried, share);
+    }
+}
+
+/// One Gauss-Seidel pass over the shape-matching groups `{i-1, i, i+1}`, root to tip.
+///
+/// The group holding the kinematic root is clamped to it: its frame is the root's orientation and its
+/// centre the root itself (infinite mass). Otherwise a rigid turn of the whole chain about its root would
+/// be a zero mode that only the particles' small orientation terms resist, and a chain could not hold a
+/// shape against gravity.
+fn match_shape(
+    group_rotation: &mut [Quat],
+    p: &mut [DVec3],
     qp: &mut [Quat],
-    input: &SubstepInput<'_>,
+    rest: &Shape,
+    orientation_weight: f32,
     alpha: f32,
-    survive: f32,
-    mut suppression: Option<(&mut [Vec3], &mut [Vec3])>,
 ) {
     let n = p.len();
-    let rest = input.rest;
     for i in 1..n {
         let lo = i - 1;
         let hi = (i + 1).min(n - 1);
-        let count = (hi - lo + 1) as f32;
-        let c = p[lo..=hi].iter().sum::<Vec3>() / count;
-        let c_rest = rest.positions[lo..=hi].iter().sum::<Vec3>() / count;
-        // Uniform masses cancel out of the group matrix.
-        let mut a = Mat3::ZERO;
-        for j in lo..=hi {
-            a += Mat3::from_quat(qp[j] * rest.orientations[j].inverse()) * input.orientation_weight;
-            let (pj, rj) = (p[j] - c, rest.positions[j] - c_rest);
-            a += Mat3::from_cols(pj * rj.x, pj * rj.y, pj * rj.z);
-        }
-        let mut rotation = state.group_rotation[i];
-        extract_rotation(&a, &mut rotation, POLAR_ITERATIONS);
-        state.group_rotation[i] = rotation;
-
-        let previous_centre = input
-            .previous_rest
-            .map(|old| old.positions[lo..=hi].iter().sum::<Vec3>() / count);
-        for j in lo.max(1)..=hi {
-            let goal = rotation * (rest.positions[j] - c_rest) + c;
-            p[j] += (goal - p[j]) * alpha;
-            if let (Some((moved, _)), Some(old), Some(old_centre)) =
-                (suppression.as_mut(), input.previous_rest, previous_centre)
-            {
-                let old_goal = rotation * (old.positions[j] - old_centre) + c;
-                moved[j] += (goal - old_goal) * (alpha * survive);
+        let (rotation, centre, rest_centre) = if lo == 0 {
+            ((qp[0] * rest.orientations[0].inverse()).normalize(), p[0], rest.positions[0])
+        } else {
+            let count = (hi - lo + 1) as f32;
+            let c = p[lo..=hi].iter().sum::<DVec3>() / count as f64;
+            let c_rest = rest.positions[lo..=hi].iter().sum::<Vec3>() / count;
+            // Uniform masses cancel out of the group matrix.
+            let mut a = Mat3::ZERO;
+            for j in lo..=hi {
+                a += Mat3::from_quat(qp[j] * rest.orientations[j].inverse()) * orientation_weight;
+                let (pj, rj) = ((p[j] - c).as_vec3(), rest.positions[j] - c_rest);
+                a += Mat3::from_cols(pj * rj.x, pj * rj.y, pj * rj.z);
             }
+            let mut rotation = group_rotation[i];
+            extract_rotation(&a, &mut rotation, POLAR_ITERATIONS);
+            (rotation, c, c_rest)
+        };
+        group_rotation[i] = rotation;
+        for j in lo.max(1)..=hi {
+            let goal = centre + (rotation * (rest.positions[j] - rest_centre)).as_dvec3();
+            p[j] += (goal - p[j]) * alpha as f64;
         }
-        let target = rotation * rest.orientations[i];
-        if let (Some((_, turned)), Some(old)) = (suppression.as_mut(), input.previous_rest) {
-            let old_target = rotation * old.orientations[i];
-            let change =
-                align_hemisphere(target * old_target.inverse(), Quat::IDENTITY).to_scaled_axis();
-            turned[i] += change * (alpha * survive);
-        }
-        qp[i] = nlerp_shorter(qp[i], target, alpha);
+        qp[i] = nlerp_shorter(qp[i], rotation * rest.orientations[i], alpha);
     }
 }

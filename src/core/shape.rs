@@ -24,45 +24,29 @@ impl Shape {
     /// normalised.
     pub fn from_joints(joints: &[Transform]) -> Result<Self> {
         if joints.len() < 2 {
-            return Err(Error::invalid_argument(format!(
-                "a chain needs at least 2 joints, got {}",
-                joints.len()
-            )));
+            return Err(Error::invalid_argument(format!("a chain needs at least 2 joints, got {}", joints.len())));
         }
         let mut positions = Vec::with_capacity(joints.len());
         let mut orientations = Vec::with_capacity(joints.len());
         for (i, joint) in joints.iter().enumerate() {
             if !joint.is_finite() {
-                return Err(Error::invalid_argument(format!(
-                    "joint {i} has a non-finite position or rotation"
-                )));
+                return Err(Error::invalid_argument(format!("joint {i} has a non-finite position or rotation")));
             }
             let norm = joint.rotation.length();
             if !(norm > 1e-6 && norm.is_finite()) {
-                return Err(Error::invalid_argument(format!(
-                    "joint {i} has a null rotation quaternion"
-                )));
+                return Err(Error::invalid_argument(format!("joint {i} has a null rotation quaternion")));
             }
             positions.push(joint.position);
             orientations.push(joint.rotation / norm);
         }
-        let extent = positions
-            .iter()
-            .map(|p| (*p - positions[0]).length())
-            .fold(0.0f32, f32::max);
+        let extent = positions.iter().map(|p| (*p - positions[0]).length()).fold(0.0f32, f32::max);
         for j in 0..positions.len() - 1 {
             let len = (positions[j + 1] - positions[j]).length();
             if !(len > MIN_RELATIVE_SEGMENT * extent && len > f32::MIN_POSITIVE) {
-                return Err(Error::invalid_argument(format!(
-                    "segment {j} (joints {j}-{}) has zero length",
-                    j + 1
-                )));
+                return Err(Error::invalid_argument(format!("segment {j} (joints {j}-{}) has zero length", j + 1)));
             }
         }
-        Ok(Self {
-            positions,
-            orientations,
-        })
+        Ok(Self { positions, orientations })
     }
 
     pub fn len(&self) -> usize {
@@ -74,10 +58,7 @@ impl Shape {
     }
 
     pub fn segment_lengths(&self) -> Vec<f32> {
-        self.positions
-            .windows(2)
-            .map(|w| (w[1] - w[0]).length())
-            .collect()
+        self.positions.windows(2).map(|w| (w[1] - w[0]).length()).collect()
     }
 
     /// Direction of the first segment: the fixed reference direction of the encoding.
@@ -105,11 +86,7 @@ pub struct ShapeFrame {
 
 impl ShapeFrame {
     pub fn from_base(base: &Shape) -> Self {
-        Self {
-            root: base.positions[0],
-            reference: base.first_direction(),
-            lengths: base.segment_lengths(),
-        }
+        Self { root: base.positions[0], reference: base.first_direction(), lengths: base.segment_lengths() }
     }
 
     pub fn chain_length(&self) -> f32 {
@@ -128,18 +105,12 @@ impl EncodedShape {
             bends.push(shortest_arc(previous, dir));
             previous = dir;
         }
-        Self {
-            bends,
-            orientations: shape.orientations.clone(),
-        }
+        Self { bends, orientations: shape.orientations.clone() }
     }
 
     /// An encoded shape of `n` joints filled with identities, for use as a reusable output buffer.
     pub fn identity(n: usize) -> Self {
-        Self {
-            bends: vec![Quat::IDENTITY; n - 1],
-            orientations: vec![Quat::IDENTITY; n],
-        }
+        Self { bends: vec![Quat::IDENTITY; n - 1], orientations: vec![Quat::IDENTITY; n] }
     }
 
     /// Forward kinematics: root, then rotate the running direction by each `r_j` and step `l_j`.
@@ -158,10 +129,7 @@ impl EncodedShape {
     pub fn decode(&self, frame: &ShapeFrame) -> Shape {
         let mut positions = vec![Vec3::ZERO; self.orientations.len()];
         self.decode_into(frame, &mut positions);
-        Shape {
-            positions,
-            orientations: self.orientations.clone(),
-        }
+        Shape { positions, orientations: self.orientations.clone() }
     }
 
     /// Re-expresses `r_0` for a new reference direction, leaving the decoded shape unchanged.
@@ -177,19 +145,14 @@ mod tests {
     use proptest::prelude::*;
 
     fn joints_from(points: &[Vec3]) -> Vec<Transform> {
-        points
-            .iter()
-            .map(|p| Transform::new(*p, Quat::IDENTITY))
-            .collect()
+        points.iter().map(|p| Transform::new(*p, Quat::IDENTITY)).collect()
     }
 
     #[test]
     fn rejects_degenerate_input() {
         assert!(Shape::from_joints(&joints_from(&[Vec3::ZERO])).is_err());
         assert!(Shape::from_joints(&joints_from(&[Vec3::ZERO, Vec3::ZERO])).is_err());
-        assert!(
-            Shape::from_joints(&joints_from(&[Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0)])).is_err()
-        );
+        assert!(Shape::from_joints(&joints_from(&[Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0)])).is_err());
         let mut j = joints_from(&[Vec3::ZERO, Vec3::Y]);
         j[1].rotation = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
         assert!(Shape::from_joints(&j).is_err());
@@ -205,20 +168,12 @@ mod tests {
 
     #[test]
     fn rebase_keeps_decoded_shape() {
-        let shape = Shape::from_joints(&joints_from(&[
-            Vec3::ZERO,
-            Vec3::X,
-            Vec3::new(1.0, 1.0, 0.0),
-        ]))
-        .unwrap();
+        let shape = Shape::from_joints(&joints_from(&[Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0)])).unwrap();
         let frame = ShapeFrame::from_base(&shape);
         let mut enc = EncodedShape::encode(&shape, frame.reference);
         let new_ref = Vec3::new(0.0, 0.6, 0.8);
         enc.rebase_reference(frame.reference, new_ref);
-        let frame2 = ShapeFrame {
-            reference: new_ref,
-            ..frame
-        };
+        let frame2 = ShapeFrame { reference: new_ref, ..frame };
         let back = enc.decode(&frame2);
         for (a, b) in back.positions.iter().zip(&shape.positions) {
             assert!((*a - *b).length() < 1e-6);

@@ -24,11 +24,7 @@ pub struct ViewWeighting {
 ///
 /// `w_i = ((d_i . d + 1) / 2)^k_i`; if they sum to 1 or more they are normalised and `w_0 = 0`, otherwise
 /// `w_0 = 1 - sum`. All weights are continuous in `d`, non-negative, and sum to 1.
-pub fn blend_weights(
-    view: Vec3,
-    shapes: impl IntoIterator<Item = ViewWeighting>,
-    out: &mut [f32],
-) -> f32 {
+pub fn blend_weights(view: Vec3, shapes: impl IntoIterator<Item = ViewWeighting>, out: &mut [f32]) -> f32 {
     let mut sum = 0.0f32;
     for (shape, w) in shapes.into_iter().zip(out.iter_mut()) {
         // Clamp: rounding can push the cosine a hair past +-1, and powf of a negative base is NaN.
@@ -52,10 +48,7 @@ mod tests {
     use glam::Quat;
 
     fn shape(direction: Vec3, influence: f32) -> ViewWeighting {
-        ViewWeighting {
-            direction,
-            influence,
-        }
+        ViewWeighting { direction, influence }
     }
 
     #[test]
@@ -81,11 +74,7 @@ mod tests {
     fn side_view_with_influences() {
         // Seen at 90 degrees: closeness 1/2, so w = 0.5^k.
         let mut w = [0.0];
-        for (k, expected) in [
-            (0.5f32, std::f32::consts::FRAC_1_SQRT_2),
-            (1.0, 0.5),
-            (8.0, 1.0 / 256.0),
-        ] {
+        for (k, expected) in [(0.5f32, std::f32::consts::FRAC_1_SQRT_2), (1.0, 0.5), (8.0, 1.0 / 256.0)] {
             let w0 = blend_weights(Vec3::Y, [shape(Vec3::X, k)], &mut w);
             assert!((w[0] - expected).abs() < 1e-6, "k={k}: {}", w[0]);
             assert!((w0 - (1.0 - expected)).abs() < 1e-6);
@@ -113,10 +102,7 @@ mod tests {
     #[test]
     fn view_direction_is_in_reference_frame() {
         // K turned 90 degrees about Y: a camera on world +X is on K's local +Z.
-        let k = Transform::new(
-            Vec3::new(0.0, 1.0, 0.0),
-            Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
-        );
+        let k = Transform::new(Vec3::new(0.0, 1.0, 0.0), Quat::from_rotation_y(std::f32::consts::FRAC_PI_2));
         let d = view_direction(Vec3::new(5.0, 1.0, 0.0), &k).unwrap();
         assert!((d - Vec3::Z).length() < 1e-6, "{d}");
         assert!(view_direction(k.position, &k).is_none());
@@ -124,11 +110,7 @@ mod tests {
 
     #[test]
     fn weights_sum_to_one_everywhere() {
-        let shapes = [
-            shape(Vec3::X, 0.7),
-            shape(-Vec3::X, 3.0),
-            shape(Vec3::Y, 1.0),
-        ];
+        let shapes = [shape(Vec3::X, 0.7), shape(-Vec3::X, 3.0), shape(Vec3::Y, 1.0)];
         let mut w = [0.0; 3];
         for i in 0..360 {
             let a = (i as f32).to_radians();

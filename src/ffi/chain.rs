@@ -1,10 +1,7 @@
 //! `kdw_chain_*`: a joint chain (`ViewDependentPhysicalObject`), its base shape and parameters.
 
 use super::engine::kdw_engine;
-use super::guard::{
-    check_out, check_struct_size, guard, read, slice, slice_mut, with_engine, with_engine_mut,
-    write,
-};
+use super::guard::{check_out, check_struct_size, guard, read, slice, slice_mut, with_engine, with_engine_mut, write};
 use super::status::{FfiResult, kdw_status};
 use super::types::{kdw_chain_def, kdw_chain_id, kdw_transform};
 use crate::core::{ChainId, ChainParams, Transform};
@@ -54,9 +51,7 @@ pub extern "C" fn kdw_chain_create(
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_chain_destroy(engine: *mut kdw_engine, chain: kdw_chain_id) -> kdw_status {
     // SAFETY: live engine handle, this thread only.
-    guard(|| unsafe {
-        with_engine_mut(engine, |e| Ok(e.destroy_chain(ChainId::from_bits(chain))?))
-    })
+    guard(|| unsafe { with_engine_mut(engine, |e| Ok(e.destroy_chain(ChainId::from_bits(chain))?)) })
 }
 
 /// `*out_valid` = 1 if `chain` names a live chain of this engine, else 0.
@@ -69,11 +64,7 @@ pub extern "C" fn kdw_chain_is_valid(
     guard(|| {
         check_out(out_valid, "out_valid")?;
         // SAFETY: live engine handle.
-        let valid = unsafe {
-            with_engine(engine, |e| {
-                Ok(e.is_chain_valid(ChainId::from_bits(chain)) as u32)
-            })
-        }?;
+        let valid = unsafe { with_engine(engine, |e| Ok(e.is_chain_valid(ChainId::from_bits(chain)) as u32)) }?;
         // SAFETY: checked by check_out.
         unsafe { write(out_valid, valid) };
         Ok(())
@@ -90,8 +81,7 @@ pub extern "C" fn kdw_chain_get_def(
     guard(|| {
         check_out(out_def, "out_def")?;
         // SAFETY: live engine handle.
-        let params =
-            unsafe { with_engine(engine, |e| Ok(e.chain_params(ChainId::from_bits(chain))?)) }?;
+        let params = unsafe { with_engine(engine, |e| Ok(e.chain_params(ChainId::from_bits(chain))?)) }?;
         // SAFETY: checked by check_out.
         unsafe { write(out_def, params.into()) };
         Ok(())
@@ -110,11 +100,7 @@ pub extern "C" fn kdw_chain_set_def(
         // SAFETY: the caller passes a readable kdw_chain_def.
         let params = params_from(unsafe { read(def, "def") }?)?;
         // SAFETY: live engine handle, this thread only.
-        unsafe {
-            with_engine_mut(engine, |e| {
-                Ok(e.set_chain_params(ChainId::from_bits(chain), params)?)
-            })
-        }
+        unsafe { with_engine_mut(engine, |e| Ok(e.set_chain_params(ChainId::from_bits(chain), params)?)) }
     })
 }
 
@@ -131,11 +117,7 @@ pub extern "C" fn kdw_chain_set_base_shape(
         // SAFETY: the caller passes `joint_count` readable transforms.
         let joints = joints_from(unsafe { slice(joints, joint_count, "joints") }?);
         // SAFETY: live engine handle, this thread only.
-        unsafe {
-            with_engine_mut(engine, |e| {
-                Ok(e.set_base_shape(ChainId::from_bits(chain), &joints)?)
-            })
-        }
+        unsafe { with_engine_mut(engine, |e| Ok(e.set_base_shape(ChainId::from_bits(chain), &joints)?)) }
     })
 }
 
@@ -156,11 +138,7 @@ pub extern "C" fn kdw_chain_joint_count(
     guard(|| {
         check_out(out_count, "out_count")?;
         // SAFETY: live engine handle.
-        let n = unsafe {
-            with_engine(engine, |e| {
-                Ok(e.chain_joint_count(ChainId::from_bits(chain))? as u32)
-            })
-        }?;
+        let n = unsafe { with_engine(engine, |e| Ok(e.chain_joint_count(ChainId::from_bits(chain))? as u32)) }?;
         // SAFETY: checked by check_out.
         unsafe { write(out_count, n) };
         Ok(())
@@ -176,14 +154,9 @@ pub extern "C" fn kdw_chain_read_world(
     capacity: u32,
     out_written: *mut u32,
 ) -> kdw_status {
-    read_chain_transforms(
-        engine,
-        chain,
-        out_transforms,
-        capacity,
-        out_written,
-        |e, id, out| e.read_chain_world(id, out),
-    )
+    read_chain_transforms(engine, chain, out_transforms, capacity, out_written, |e, id, out| {
+        e.read_chain_world(id, out)
+    })
 }
 
 /// The rest shape the chain is currently pulled towards (the blend of its shapes for the last view
@@ -196,14 +169,9 @@ pub extern "C" fn kdw_chain_read_rest_shape(
     capacity: u32,
     out_written: *mut u32,
 ) -> kdw_status {
-    read_chain_transforms(
-        engine,
-        chain,
-        out_transforms,
-        capacity,
-        out_written,
-        |e, id, out| e.chain_rest_shape(id, out),
-    )
+    read_chain_transforms(engine, chain, out_transforms, capacity, out_written, |e, id, out| {
+        e.chain_rest_shape(id, out)
+    })
 }
 
 /// Kinetic energy of the chain's dynamic joints, J (mass x velocity^2 / 2 summed).
@@ -216,11 +184,7 @@ pub extern "C" fn kdw_chain_kinetic_energy(
     guard(|| {
         check_out(out_energy, "out_energy")?;
         // SAFETY: live engine handle.
-        let energy = unsafe {
-            with_engine(engine, |e| {
-                Ok(e.chain_kinetic_energy(ChainId::from_bits(chain))?)
-            })
-        }?;
+        let energy = unsafe { with_engine(engine, |e| Ok(e.chain_kinetic_energy(ChainId::from_bits(chain))?)) }?;
         // SAFETY: checked by check_out.
         unsafe { write(out_energy, energy) };
         Ok(())
@@ -233,11 +197,7 @@ fn read_chain_transforms(
     out_transforms: *mut kdw_transform,
     capacity: u32,
     out_written: *mut u32,
-    read_into: impl FnOnce(
-        &crate::core::Engine,
-        ChainId,
-        &mut [Transform],
-    ) -> crate::core::Result<usize>,
+    read_into: impl FnOnce(&crate::core::Engine, ChainId, &mut [Transform]) -> crate::core::Result<usize>,
 ) -> kdw_status {
     guard(|| {
         check_out(out_written, "out_written")?;

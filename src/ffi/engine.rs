@@ -3,13 +3,11 @@
 use glam::Quat;
 
 use super::guard::{
-    check_out, check_struct_size, destroy_handle, guard, into_handle, read, slice, slice_mut,
-    with_engine, with_engine_mut, write,
+    check_out, check_struct_size, destroy_handle, guard, into_handle, read, slice, slice_mut, with_engine,
+    with_engine_mut, write,
 };
 use super::status::kdw_status;
-use super::types::{
-    kdw_chain_id, kdw_engine_def, kdw_engine_stats, kdw_quat, kdw_transform, kdw_vec3,
-};
+use super::types::{kdw_chain_id, kdw_engine_def, kdw_engine_stats, kdw_quat, kdw_transform, kdw_vec3};
 use crate::core::{Engine, EngineSettings, Transform};
 
 /// One per character: owns chains and view shapes, gravity and solver settings. Opaque.
@@ -25,10 +23,7 @@ pub extern "C" fn kdw_engine_def_default() -> kdw_engine_def {
 
 /// Creates an engine. `*out_engine` receives it; destroy it with `kdw_engine_destroy`.
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_engine_create(
-    def: *const kdw_engine_def,
-    out_engine: *mut *mut kdw_engine,
-) -> kdw_status {
+pub extern "C" fn kdw_engine_create(def: *const kdw_engine_def, out_engine: *mut *mut kdw_engine) -> kdw_status {
     guard(|| {
         check_out(out_engine, "out_engine")?;
         // SAFETY: the caller passes a readable kdw_engine_def (NULL and alignment are checked).
@@ -50,10 +45,7 @@ pub extern "C" fn kdw_engine_destroy(engine: *mut kdw_engine) -> kdw_status {
 
 /// Reads the engine's current settings.
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_engine_get_def(
-    engine: *const kdw_engine,
-    out_def: *mut kdw_engine_def,
-) -> kdw_status {
+pub extern "C" fn kdw_engine_get_def(engine: *const kdw_engine, out_def: *mut kdw_engine_def) -> kdw_status {
     guard(|| {
         check_out(out_def, "out_def")?;
         // SAFETY: `engine` is a live engine handle (caller contract).
@@ -66,10 +58,7 @@ pub extern "C" fn kdw_engine_get_def(
 
 /// Replaces all settings at once (validated as a whole; nothing changes on error).
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_engine_set_def(
-    engine: *mut kdw_engine,
-    def: *const kdw_engine_def,
-) -> kdw_status {
+pub extern "C" fn kdw_engine_set_def(engine: *mut kdw_engine, def: *const kdw_engine_def) -> kdw_status {
     guard(|| {
         // SAFETY: the caller passes a readable kdw_engine_def.
         let def = unsafe { read(def, "def") }?;
@@ -81,10 +70,7 @@ pub extern "C" fn kdw_engine_set_def(
 
 /// Sets world gravity, m/s².
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_engine_set_gravity(
-    engine: *mut kdw_engine,
-    gravity: *const kdw_vec3,
-) -> kdw_status {
+pub extern "C" fn kdw_engine_set_gravity(engine: *mut kdw_engine, gravity: *const kdw_vec3) -> kdw_status {
     guard(|| {
         // SAFETY: the caller passes a readable kdw_vec3.
         let gravity = unsafe { read(gravity, "gravity") }?;
@@ -127,20 +113,13 @@ pub extern "C" fn kdw_engine_set_anchors(
         // SAFETY: the caller passes `count` readable transforms.
         let anchors = unsafe { slice(anchors, count, "anchors") }?;
         // SAFETY: live engine handle, this thread only.
-        unsafe {
-            with_engine_mut(engine, |e| {
-                Ok(e.set_anchors(anchors.iter().map(|t| Transform::from(*t)))?)
-            })
-        }
+        unsafe { with_engine_mut(engine, |e| Ok(e.set_anchors(anchors.iter().map(|t| Transform::from(*t)))?)) }
     })
 }
 
 /// Number of chains.
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_engine_chain_count(
-    engine: *const kdw_engine,
-    out_count: *mut u32,
-) -> kdw_status {
+pub extern "C" fn kdw_engine_chain_count(engine: *const kdw_engine, out_count: *mut u32) -> kdw_status {
     guard(|| {
         check_out(out_count, "out_count")?;
         // SAFETY: live engine handle.
@@ -153,10 +132,7 @@ pub extern "C" fn kdw_engine_chain_count(
 
 /// Total number of joints of all chains: the size `kdw_engine_read_world` needs.
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_engine_joint_count(
-    engine: *const kdw_engine,
-    out_count: *mut u32,
-) -> kdw_status {
+pub extern "C" fn kdw_engine_joint_count(engine: *const kdw_engine, out_count: *mut u32) -> kdw_status {
     guard(|| {
         check_out(out_count, "out_count")?;
         // SAFETY: live engine handle.
@@ -266,10 +242,7 @@ pub extern "C" fn kdw_engine_read_local_rotations(
 
 /// Counters: chains, joints, substeps run, time dropped, chains asleep.
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_engine_get_stats(
-    engine: *const kdw_engine,
-    out_stats: *mut kdw_engine_stats,
-) -> kdw_status {
+pub extern "C" fn kdw_engine_get_stats(engine: *const kdw_engine, out_stats: *mut kdw_engine_stats) -> kdw_status {
     guard(|| {
         check_out(out_stats, "out_stats")?;
         // SAFETY: live engine handle.
@@ -290,10 +263,7 @@ pub extern "C" fn kdw_engine_reset(engine: *mut kdw_engine) -> kdw_status {
 /// A hash of everything that determines future results. Equal hashes after equal calls show determinism;
 /// an unchanged hash after a rejected call shows the engine was left untouched.
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_engine_state_hash(
-    engine: *const kdw_engine,
-    out_hash: *mut u64,
-) -> kdw_status {
+pub extern "C" fn kdw_engine_state_hash(engine: *const kdw_engine, out_hash: *mut u64) -> kdw_status {
     guard(|| {
         check_out(out_hash, "out_hash")?;
         // SAFETY: live engine handle.

@@ -5,8 +5,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use super::engine::kdw_engine;
 use super::status::{
-    FfiError, FfiResult, KDW_STATUS_NULL_POINTER, KDW_STATUS_OK, KDW_STATUS_PANIC, kdw_status,
-    set_last_error,
+    FfiError, FfiResult, KDW_STATUS_NULL_POINTER, KDW_STATUS_OK, KDW_STATUS_PANIC, kdw_status, set_last_error,
 };
 use crate::core::Engine;
 
@@ -37,16 +36,10 @@ fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
 
 fn check_pointer<T>(ptr: *const T, what: &str) -> FfiResult<()> {
     if ptr.is_null() {
-        return Err(FfiError::new(
-            KDW_STATUS_NULL_POINTER,
-            format!("{what} is NULL"),
-        ));
+        return Err(FfiError::new(KDW_STATUS_NULL_POINTER, format!("{what} is NULL")));
     }
     if !ptr.is_aligned() {
-        return Err(FfiError::new(
-            KDW_STATUS_NULL_POINTER,
-            format!("{what} is misaligned"),
-        ));
+        return Err(FfiError::new(KDW_STATUS_NULL_POINTER, format!("{what} is misaligned")));
     }
     Ok(())
 }
@@ -103,18 +96,11 @@ pub(crate) struct EngineBox {
 }
 
 fn poisoned_error() -> FfiError {
-    FfiError::new(
-        KDW_STATUS_PANIC,
-        "the engine was poisoned by an earlier internal error; destroy it",
-    )
+    FfiError::new(KDW_STATUS_PANIC, "the engine was poisoned by an earlier internal error; destroy it")
 }
 
 pub(crate) fn into_handle(engine: Engine) -> *mut kdw_engine {
-    Box::into_raw(Box::new(EngineBox {
-        engine,
-        poisoned: false,
-    }))
-    .cast()
+    Box::into_raw(Box::new(EngineBox { engine, poisoned: false })).cast()
 }
 
 /// # Safety
@@ -161,10 +147,7 @@ pub(crate) unsafe fn with_engine_mut<R>(
         Ok(result) => result,
         Err(payload) => {
             boxed.poisoned = true;
-            Err(FfiError::new(
-                KDW_STATUS_PANIC,
-                panic_message(payload.as_ref()),
-            ))
+            Err(FfiError::new(KDW_STATUS_PANIC, panic_message(payload.as_ref())))
         }
     }
 }

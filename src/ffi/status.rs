@@ -35,10 +35,7 @@ pub struct FfiError {
 
 impl FfiError {
     pub fn new(status: kdw_status, message: impl Into<String>) -> Self {
-        Self {
-            status,
-            message: message.into(),
-        }
+        Self { status, message: message.into() }
     }
 }
 
@@ -50,10 +47,7 @@ impl From<Error> for FfiError {
             ErrorKind::CapacityExceeded => KDW_STATUS_CAPACITY_EXCEEDED,
             ErrorKind::BufferTooSmall => KDW_STATUS_BUFFER_TOO_SMALL,
         };
-        Self {
-            status,
-            message: e.message,
-        }
+        Self { status, message: e.message }
     }
 }
 
@@ -93,11 +87,7 @@ pub extern "C" fn kdw_status_str(status: kdw_status) -> *const c_char {
 /// `KDW_STATUS_BUFFER_TOO_SMALL` is returned; `*out_length` still receives the full length. `buffer` may
 /// be NULL when `capacity` is 0, to query the length.
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_last_error_message(
-    buffer: *mut c_char,
-    capacity: u32,
-    out_length: *mut u32,
-) -> kdw_status {
+pub extern "C" fn kdw_last_error_message(buffer: *mut c_char, capacity: u32, out_length: *mut u32) -> kdw_status {
     let result = std::panic::catch_unwind(|| {
         LAST_ERROR.with(|slot| {
             let message = slot.borrow();
@@ -119,11 +109,7 @@ pub extern "C" fn kdw_last_error_message(
                 // SAFETY: non-NULL, and the caller guarantees it points to a writable uint32_t.
                 unsafe { *out_length = bytes.len() as u32 };
             }
-            if fits || capacity == 0 && buffer.is_null() {
-                KDW_STATUS_OK
-            } else {
-                KDW_STATUS_BUFFER_TOO_SMALL
-            }
+            if fits || capacity == 0 && buffer.is_null() { KDW_STATUS_OK } else { KDW_STATUS_BUFFER_TOO_SMALL }
         })
     });
     result.unwrap_or(KDW_STATUS_PANIC)

@@ -122,11 +122,7 @@ impl From<kdw_vec3> for Vec3 {
 
 impl From<Vec3> for kdw_vec3 {
     fn from(v: Vec3) -> Self {
-        Self {
-            x: v.x,
-            y: v.y,
-            z: v.z,
-        }
+        Self { x: v.x, y: v.y, z: v.z }
     }
 }
 
@@ -138,12 +134,7 @@ impl From<kdw_quat> for Quat {
 
 impl From<Quat> for kdw_quat {
     fn from(q: Quat) -> Self {
-        Self {
-            x: q.x,
-            y: q.y,
-            z: q.z,
-            w: q.w,
-        }
+        Self { x: q.x, y: q.y, z: q.z, w: q.w }
     }
 }
 
@@ -155,10 +146,7 @@ impl From<kdw_transform> for Transform {
 
 impl From<Transform> for kdw_transform {
     fn from(t: Transform) -> Self {
-        Self {
-            position: t.position.into(),
-            rotation: t.rotation.into(),
-        }
+        Self { position: t.position.into(), rotation: t.rotation.into() }
     }
 }
 
@@ -216,9 +204,7 @@ impl TryFrom<&kdw_chain_def> for ChainParams {
             KDW_ANCHOR_VIEW_REFERENCE => AnchorSource::ViewReference,
             KDW_ANCHOR_OWN => AnchorSource::Own,
             other => {
-                return Err(crate::core::Error::invalid_argument(format!(
-                    "unknown anchor source {other}"
-                )));
+                return Err(crate::core::Error::invalid_argument(format!("unknown anchor source {other}")));
             }
         };
         Ok(Self {

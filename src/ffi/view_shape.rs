@@ -31,12 +31,7 @@ pub extern "C" fn kdw_chain_add_view_shape(
         // SAFETY: live engine handle, this thread only.
         let id = unsafe {
             with_engine_mut(engine, |e| {
-                Ok(e.add_view_shape(
-                    ChainId::from_bits(chain),
-                    (*direction).into(),
-                    &joints,
-                    influence,
-                )?)
+                Ok(e.add_view_shape(ChainId::from_bits(chain), (*direction).into(), &joints, influence)?)
             })
         }?;
         // SAFETY: checked by check_out.
@@ -54,9 +49,7 @@ pub extern "C" fn kdw_view_shape_set_influence(
 ) -> kdw_status {
     // SAFETY: live engine handle, this thread only.
     guard(|| unsafe {
-        with_engine_mut(engine, |e| {
-            Ok(e.set_view_shape_influence(ViewShapeId::from_bits(view_shape), influence)?)
-        })
+        with_engine_mut(engine, |e| Ok(e.set_view_shape_influence(ViewShapeId::from_bits(view_shape), influence)?))
     })
 }
 
@@ -73,10 +66,7 @@ pub extern "C" fn kdw_view_shape_set_direction(
         // SAFETY: live engine handle, this thread only.
         unsafe {
             with_engine_mut(engine, |e| {
-                Ok(e.set_view_shape_direction(
-                    ViewShapeId::from_bits(view_shape),
-                    (*direction).into(),
-                )?)
+                Ok(e.set_view_shape_direction(ViewShapeId::from_bits(view_shape), (*direction).into())?)
             })
         }
     })
@@ -95,25 +85,16 @@ pub extern "C" fn kdw_view_shape_set_joints(
         let joints = joints_from(unsafe { slice(joints, joint_count, "joints") }?);
         // SAFETY: live engine handle, this thread only.
         unsafe {
-            with_engine_mut(engine, |e| {
-                Ok(e.set_view_shape_joints(ViewShapeId::from_bits(view_shape), &joints)?)
-            })
+            with_engine_mut(engine, |e| Ok(e.set_view_shape_joints(ViewShapeId::from_bits(view_shape), &joints)?))
         }
     })
 }
 
 /// Removes a view shape from its chain.
 #[unsafe(no_mangle)]
-pub extern "C" fn kdw_view_shape_remove(
-    engine: *mut kdw_engine,
-    view_shape: kdw_view_shape_id,
-) -> kdw_status {
+pub extern "C" fn kdw_view_shape_remove(engine: *mut kdw_engine, view_shape: kdw_view_shape_id) -> kdw_status {
     // SAFETY: live engine handle, this thread only.
-    guard(|| unsafe {
-        with_engine_mut(engine, |e| {
-            Ok(e.remove_view_shape(ViewShapeId::from_bits(view_shape))?)
-        })
-    })
+    guard(|| unsafe { with_engine_mut(engine, |e| Ok(e.remove_view_shape(ViewShapeId::from_bits(view_shape))?)) })
 }
 
 /// Number of view shapes of a chain.
@@ -127,9 +108,7 @@ pub extern "C" fn kdw_chain_view_shape_count(
         check_out(out_count, "out_count")?;
         // SAFETY: live engine handle.
         let n = unsafe {
-            super::guard::with_engine(engine, |e| {
-                Ok(e.view_shape_count(ChainId::from_bits(chain))? as u32)
-            })
+            super::guard::with_engine(engine, |e| Ok(e.view_shape_count(ChainId::from_bits(chain))? as u32))
         }?;
         // SAFETY: checked by check_out.
         unsafe { write(out_count, n) };

@@ -5,16 +5,12 @@ use std::path::{Path, PathBuf};
 
 /// The kodawari crate's root directory.
 pub fn crate_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../..")
-        .canonicalize()
-        .expect("crate root")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().expect("crate root")
 }
 
 /// The header text cbindgen generates for the crate at `crate_dir`.
 pub fn generate_header(crate_dir: &Path) -> String {
-    let config =
-        cbindgen::Config::from_file(crate_dir.join("cbindgen.toml")).expect("cbindgen.toml");
+    let config = cbindgen::Config::from_file(crate_dir.join("cbindgen.toml")).expect("cbindgen.toml");
     // Parse only src/ffi/: the core's public items are not part of the C API.
     let bindings = cbindgen::Builder::new()
         .with_src(crate_dir.join("src/ffi/mod.rs"))

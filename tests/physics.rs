@@ -1,0 +1,189 @@
+//! Physical properties of the engine through its Rust API (SPEC 3.4-3.6, 6.1). Each test prints the
+//! figure it measures (`cargo test --test physics -- --nocapture`).
+
+mod common;
+
+use common::*;
+use glam::{Quat, Vec3};
+use kodawari::{ChainParams, EngineSettings, Transform};
+
+const HEAD: Vec3 = Vec3::new(0.0, 1.6, 0.0);
+
+/// A limp 9-joint chain released horizontally swings hard; every segment keeps its length within 1e-4.
+#[test]
+fn swinging_chain_is_inextensible() {
+    let mut engine = engine_with(EngineSettings::default());
+    let base = straight_chain(9, Vec3::ZERO, Vec3::X, 0.1);
+    let lengths = segment_lengths(&base);
+    let id = engine.create_chain(limp(), &base).unwrap();
+    let mut worst = 0.0f32;
+    for frame in 0..240 {
+        let _ = frame;
+        engine.step(1.0 / 60.0, Vec3::new(0.0, 0.0, 5.0), at(HEAD)).unwrap();
+        worst = worst.max(max_stretch(&chain_world(&engine, id), &lengths));
+    }
+    println!("max relative stretch, 9-joint limp chain, 4 s at 60 fps: {worst:.2e}");
+    assert!(worst <= 1e-4, "stretch {worst}");
+}
+
+/// A single pendulum's small-angle period is 2 pi sqrt(L / g).
+#[test]
+fn pendulum_period_matches_theory() {
+    let settings = EngineSettings::default();
+    let mut engine = engine_with(settings);
+    let length = 0.5f32;
+    let angle = 0.05f32;
+    let base = vec![
+        Transform::new(Vec3::ZERO, Quat::IDENTITY),
+        Transform::new(Vec3::new(length * angle.sin(), -length * angle.cos(), 0.0), Quat::IDENTITY),
+    ];
+    let id = engine.create_chain(limp(), &base).unwrap();
+    let dt = 1.0 / 960.0;
+    let mut previous_x = f32::NAN;
+    let mut crossings = Vec::new();
+    for frame in 0..(960 * 4) {
+        engine.step(dt, Vec3::new(0.0, 0.0, 5.0), at(HEAD)).unwrap();
+        let x = chain_world(&engine, id)[1].position.x;
+        if previous_x > 0.0 && x <= 0.0 {
+            // Linear interpolation of the downward zero crossing.
+            crossings.push((frame as f32 - 1.0 + previous_x / (previous_x - x)) * dt);
+        }
+        previous_x = x;
+    }
+    let periods: Vec<f32> = crossings.windows(2).map(|w| w[1] - w[0]).collect();
+    let measured = periods.iter().sum::<f32>() / periods.len() as f32;
+    // Small-angle period with the first finite-amplitude correction (1 + theta^2 / 16).
+    let theory = 2.0 * std::f32::consts::PI * (length / 9.81f32).sqrt() * (1.0 + angle * angle / 16.0);
+    println!(
+        "pendulum period: measured {measured:.6} s, theory {theory:.6} s, relative error {:.2e}",
+        measured / theory - 1.0
+    );
+    assert!((measured / theory - 1.0).abs() < 1e-3);
+}
+
+/// Without gravity and with a still root, a chain settles onto the blended rest shape.
+#[test]
+fn settles_to_blended_rest_shape() {
+    let settings = EngineSettings { gravity: Vec3::ZERO, ..Default::default() };
+    let mut engine = engine_with(settings);
+    let base = straight_chain(8, Vec3::new(0.0, 0.1, 0.0), Vec3::Y, 0.03);
+    let left = curled_chain(8, Vec3::new(0.0, 0.1, 0.0), Vec3::Y, Vec3::Z, 0.25, 0.03);
+    let right = curled_chain(8, Vec3::new(0.0, 0.1, 0.0), Vec3::Y, -Vec3::Z, 0.15, 0.03);
+    let id = engine.create_chain(ChainParams::default(), &base).unwrap();
+    engine.add_view_shape(id, -Vec3::X, &left, 1.0).unwrap();
+    engine.add_view_shape(id, Vec3::X, &right, 2.0).unwrap();
+    // Start seen from one side, then park the camera at an oblique view so the rest shape is a blend.
+    engine.step(1.0 / 60.0, HEAD + Vec3::new(-3.0, 0.0, 0.0), at(HEAD)).unwrap();
+    let camera = HEAD + Vec3::new(1.0, 0.2, 1.5);
+    for _ in 0..(60 * 30) {
+        engine.step(1.0 / 60.0, camera, at(HEAD)).unwrap();
+    }
+    let mut rest = vec![Transform::IDENTITY; 8];
+    engine.chain_rest_shape(id, &mut rest).unwrap();
+    let out = chain_world(&engine, id);
+    let length = chain_length(&base);
+    let error =
+        out.iter().zip(&rest).map(|(o, r)| (o.position - (HEAD + r.position)).length()).fold(0.0, f32::max) / length;
+    let bend = (rest[7].position - base[7].position).length() / length;
+    println!(
+        "rest fidelity: max joint error {error:.2e} chain lengths (blend differs from base by {bend:.2} chain lengths)"
+    );
+    assert!(bend > 0.1, "the blend must differ from the base for this test to mean anything");
+    assert!(error <= 1e-5, "error {error}");
+}
+
+/// Root swaying 0.2 m at 1 Hz for 3 s: the tip's path at 30, 60, 144 and 240 fps matches the 960 fps run.
+#[test]
+fn frame_rate_invariance() {
+    let base = curled_chain(9, Vec3::ZERO, Vec3::new(1.0, -1.0, 0.0), Vec3::Z, 0.1, 0.05);
+    let length = chain_length(&base);
+    let duration = 3.5f64;
+    let run = |fps: u32| -> Vec<(f64, Vec3)> {
+        let mut engine = engine_with(EngineSettings::default());
+        let id = engine.create_chain(ChainParams::default(), &base).unwrap();
+        let frames = (duration * fps as f64).round() as u32;
+        let mut tips = Vec::with_capacity(frames as usize);
+        for frame in 1..=frames {
+            let t = frame as f64 / fps as f64;
+            // Still until 0.5 s (a frame boundary at every rate), so every run starts from the same state
+            // whenever its first frame lands.
+            let phase = (t - 0.5).max(0.0);
+            let root = HEAD + Vec3::new(0.2 * (2.0 * std::f64::consts::PI * phase).sin() as f32, 0.0, 0.0);
+            engine.step(1.0 / fps as f32, root + Vec3::new(0.0, 0.0, 3.0), at(root)).unwrap();
+            tips.push((t, chain_world(&engine, id)[8].position));
+        }
+        tips
+    };
+    let reference = run(960);
+    for fps in [30u32, 60, 144, 240] {
+        let tips = run(fps);
+        let common = gcd(fps, 960);
+        let (stride, ref_stride) = ((fps / common) as usize, (960 / common) as usize);
+        let (mut sum, mut count, mut worst) = (0.0f32, 0usize, 0.0f32);
+        for (i, (t, tip)) in tips.iter().enumerate().skip(stride - 1).step_by(stride) {
+            let (rt, rtip) = reference[(i + 1) / stride * ref_stride - 1];
+            assert!((t - rt).abs() < 1e-9);
+            let e = (*tip - rtip).length() / length;
+            sum += e * e;
+            count += 1;
+            worst = worst.max(e);
+        }
+        let rms = (sum / count as f32).sqrt();
+        println!("frame-rate invariance at {fps} fps vs 960: RMS tip error {rms:.2e}, max {worst:.2e} chain lengths");
+        assert!(rms <= 0.01, "{fps} fps: rms {rms}");
+    }
+}
+
+fn gcd(a: u32, b: u32) -> u32 {
+    if b == 0 { a } else { gcd(b, a % b) }
+}
+
+/// Camera orbiting at 180 deg/s around a chain with two view shapes, no gravity: momentum suppression
+/// keeps the chain from whipping.
+#[test]
+fn momentum_suppression_tames_orbiting_camera() {
+    let base = straight_chain(8, Vec3::new(0.0, 0.1, 0.0), Vec3::Y, 0.04);
+    let left = curled_chain(8, Vec3::new(0.0, 0.1, 0.0), Vec3::Y, Vec3::Z, 0.3, 0.04);
+    let right = curled_chain(8, Vec3::new(0.0, 0.1, 0.0), Vec3::Y, -Vec3::Z, 0.3, 0.04);
+    let length = chain_length(&base);
+    let run = |stiffness: f32, suppression: f32| -> (f32, f32, f32) {
+        let settings = EngineSettings { gravity: Vec3::ZERO, ..Default::default() };
+        let mut engine = engine_with(settings);
+        let params = ChainParams { stiffness, momentum_suppression: suppression, damping: 0.0, ..Default::default() };
+        let id = engine.create_chain(params, &base).unwrap();
+        engine.add_view_shape(id, -Vec3::X, &left, 1.0).unwrap();
+        engine.add_view_shape(id, Vec3::X, &right, 1.0).unwrap();
+        let (mut peak, mut worst_track) = (0.0f32, 0.0f32);
+        let mut rest = vec![Transform::IDENTITY; 8];
+        for frame in 0..120 {
+            let angle = std::f32::consts::PI * frame as f32 / 60.0;
+            engine.step(1.0 / 60.0, orbit_camera(HEAD, 3.0, angle), at(HEAD)).unwrap();
+            peak = peak.max(engine.chain_kinetic_energy(id).unwrap());
+            engine.chain_rest_shape(id, &mut rest).unwrap();
+            let out = chain_world(&engine, id);
+            let track =
+                out.iter().zip(&rest).map(|(o, r)| (o.position - (HEAD + r.position)).length()).fold(0.0, f32::max);
+            worst_track = worst_track.max(track / length);
+        }
+        // The orbit stops: what energy is left?
+        let stop_angle = std::f32::consts::PI * 2.0;
+        engine.step(1.0 / 60.0, orbit_camera(HEAD, 3.0, stop_angle), at(HEAD)).unwrap();
+        let residual = engine.chain_kinetic_energy(id).unwrap();
+        (peak, residual, worst_track)
+    };
+    for stiffness in [0.1f32, 0.5, 0.9, 0.99, 1.0] {
+        let (peak_on, residual_on, track_on) = run(stiffness, 1.0);
+        let (peak_off, residual_off, track_off) = run(stiffness, 0.0);
+        println!(
+            "stiffness {stiffness}: peak KE on/off {peak_on:.3e}/{peak_off:.3e} (ratio {:.3}), residual KE ratio {:.3}, tracking error on/off {track_on:.4}/{track_off:.4} chain lengths",
+            peak_on / peak_off,
+            residual_on / residual_off
+        );
+        // Stiff chains follow their rest shape, so what the changing rest shape injects is all there is:
+        // suppression must remove nearly all of it. Soft chains lag and swing by design (reported only).
+        if stiffness >= 0.9 {
+            assert!(peak_on <= 0.01 * peak_off, "stiffness {stiffness}: peak KE ratio {}", peak_on / peak_off);
+            assert!(track_on <= 0.02, "stiffness {stiffness}: tracking error {track_on} chain lengths");
+        }
+    }
+}

@@ -519,7 +519,6 @@ impl Engine {
             words.push(chain.placed as u64 | (chain.half_kick as u64) << 1 | (chain.rest_changed as u64) << 2);
             words.push(chain.views.len() as u64);
             for view in &chain.views {
-                words.push(view.id.to_bits());
                 words.extend(
                     [
                         view.weighting.direction.x,

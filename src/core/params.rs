@@ -131,7 +131,9 @@ impl ChainParams {
     }
 
     /// Fraction of the way to the goals per substep of length `h`: `1 - exp(-(omega h)^2)`, a spring of
-    /// frequency omega for small `omega h`, saturating at 1 (rigid) as the stiffness reaches 1.
+    /// frequency omega for small `omega h` (acceleration `omega^2` times the distance to the goal, whatever
+    /// `h`), saturating at 1 (rigid) as the stiffness reaches 1. Where `omega h > 1` the spring is stiffer
+    /// than one substep can resolve and the chain is simply rigid at that rate.
     pub fn alpha_per_substep(&self, h: f32) -> f32 {
         if self.stiffness <= 0.0 {
             return 0.0;

@@ -7,6 +7,8 @@
 //! - [`core`]: the engine in plain safe Rust.
 //! - `ffi` (not public in Rust): the C ABI in `include/kodawari.h`, the only place with `extern "C"`.
 #![deny(unsafe_op_in_unsafe_fn)]
+// Numerical kernels index several parallel arrays with one joint index; iterator zips would hide that.
+#![allow(clippy::needless_range_loop)]
 
 pub mod core;
 mod ffi;

@@ -210,7 +210,7 @@ fn output_rotations_point_bones_at_children() {
     engine.read_local_rotations(&mut locals).unwrap();
     let mut world = Quat::IDENTITY;
     for (local, o) in locals.iter().zip(&out) {
-        world = world * *local;
+        world *= *local;
         assert!(world.angle_between(o.rotation) < 1e-4);
     }
 }

@@ -119,6 +119,8 @@ pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f3
 
 /// Solves the tridiagonal system in `s` (diag, lower, upper, residual as right-hand side) and adds the
 /// solution to `s.lambda`. Returns `false` on a vanishing pivot or a non-finite result.
+// `!(x > y)` on purpose: a NaN must fail the check too.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 fn thomas_solve(s: &mut ConstraintScratch, m: usize) -> bool {
     let scale = s.diag[..m].iter().fold(0.0f32, |a, b| a.max(b.abs()));
     let tiny = scale * 1e-7;

@@ -257,7 +257,12 @@ pub extern "C" fn kdw_engine_get_stats(engine: *const kdw_engine, out_stats: *mu
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engine_reset(engine: *mut kdw_engine) -> kdw_status {
     // SAFETY: live engine handle, this thread only.
-    guard(|| unsafe { with_engine_mut(engine, |e| Ok(e.reset_all())) })
+    guard(|| unsafe {
+        with_engine_mut(engine, |e| {
+            e.reset_all();
+            Ok(())
+        })
+    })
 }
 
 /// A hash of everything that determines future results. Equal hashes after equal calls show determinism;

@@ -1,17 +1,13 @@
 //! The shared library exports the C API and nothing else, and every exported function is in the header.
 
-use std::path::PathBuf;
-use std::process::Command;
+#[path = "common/native.rs"]
+mod native;
 
-/// `target/<profile>/`: the integration test binary lives in its `deps/` folder.
-fn library_dir() -> PathBuf {
-    let exe = std::env::current_exe().expect("test binary path");
-    exe.parent().and_then(|deps| deps.parent()).expect("target profile dir").to_path_buf()
-}
+use std::process::Command;
 
 #[test]
 fn only_kdw_symbols_are_exported_and_all_are_declared() {
-    let library = library_dir().join("libkodawari.so");
+    let library = native::shared_library_dir().join("libkodawari.so");
     assert!(library.exists(), "{} not built", library.display());
     let output = Command::new("nm").args(["-D", "--defined-only"]).arg(&library).output().expect("run nm (binutils)");
     assert!(output.status.success());

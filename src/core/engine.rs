@@ -9,7 +9,7 @@ use glam::{Quat, Vec3};
 use super::arena::{Arena, Id, Kind};
 use super::chain::{Chain, ViewShape, ViewShapeId, relative_rotation};
 use super::error::{Error, Result};
-use super::math::{Transform, direction, rotation_angle};
+use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
 use super::params::{AnchorSource, ChainParams, EngineSettings};
 use super::rod::{RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
@@ -106,7 +106,9 @@ impl Engine {
         if !self.chains.has_room() {
             return Err(Error::capacity("the engine holds the maximum number of chains"));
         }
-        let chain = Chain::new(params, joints)?;
+        let mut chain = Chain::new(params, joints)?;
+        // Until its first step a new chain reads back in its rest shape under the last known anchor.
+        chain.anchor = self.view_reference.unwrap_or(Transform::IDENTITY);
         let n = chain.joint_count();
         let id = self.chains.insert(chain).expect("room checked above");
         self.order.push(self.chains.index_of(id).expect("just inserted") as u32);
@@ -194,7 +196,12 @@ impl Engine {
         }
         for (&slot, anchor) in self.order.iter().zip(anchors) {
             let chain = self.chains.at_mut(slot as usize).expect("order holds live chains");
-            chain.anchor_pending = Transform::new(anchor.position, anchor.rotation.normalize());
+            let anchor = validate_transform(&anchor).expect("validated above");
+            chain.anchor_pending = anchor;
+            if !chain.placed && chain.params.anchor == AnchorSource::Own {
+                // Until its first step a new chain reads back in its rest shape under this anchor.
+                chain.anchor = anchor;
+            }
         }
         Ok(())
     }
@@ -281,11 +288,11 @@ impl Engine {
         if !camera.is_finite() {
             return Err(Error::invalid_argument("camera position must be finite"));
         }
-        validate_transform(&view_reference).map_err(|e| Error::invalid_argument(format!("view reference: {e}")))?;
+        let k =
+            validate_transform(&view_reference).map_err(|e| Error::invalid_argument(format!("view reference: {e}")))?;
         if dt == 0.0 {
             return Ok(());
         }
-        let k = Transform::new(view_reference.position, view_reference.rotation.normalize());
 
         // Rebase the particle state on the new origin.
         let origin = k.position;
@@ -568,23 +575,21 @@ fn is_teleport(from: &Transform, to: &Transform, settings: &EngineSettings) -> b
         || rotation_angle(from.rotation.inverse() * to.rotation) > settings.teleport_angle
 }
 
-/// A transform from outside: finite, with a rotation that can be normalised.
-pub(crate) fn validate_transform(t: &Transform) -> Result<()> {
+/// A transform from outside, checked and with its rotation normalised: finite, rotation not all zero.
+pub(crate) fn validate_transform(t: &Transform) -> Result<Transform> {
     if !t.is_finite() {
         return Err(Error::invalid_argument("non-finite position or rotation"));
     }
-    let norm = t.rotation.length();
-    if !(norm > 1e-6 && norm.is_finite()) {
-        return Err(Error::invalid_argument("null rotation quaternion"));
-    }
-    Ok(())
+    let rotation =
+        normalized_rotation(t.rotation).ok_or_else(|| Error::invalid_argument("null rotation quaternion"))?;
+    Ok(Transform::new(t.position, rotation))
 }
 
 fn validate_direction(d: Vec3) -> Result<Vec3> {
     if !d.is_finite() {
         return Err(Error::invalid_argument("view direction must be finite"));
     }
-    direction(d).ok_or_else(|| Error::invalid_argument("view direction must not be zero"))
+    normalized_direction(d).ok_or_else(|| Error::invalid_argument("view direction must not be zero"))
 }
 
 fn validate_influence(k: f32) -> Result<()> {

@@ -115,6 +115,25 @@ pub fn rotation_angle(q: Quat) -> f32 {
     2.0 * q.xyz().length().atan2(q.w.abs())
 }
 
+/// `q` normalised, for any finite non-zero input (tiny or huge components alike: the largest component
+/// is scaled to 1 first, so squaring neither underflows nor overflows); `None` for zero or non-finite.
+pub fn normalized_rotation(q: Quat) -> Option<Quat> {
+    let largest = q.x.abs().max(q.y.abs()).max(q.z.abs()).max(q.w.abs());
+    if !(largest > 0.0 && largest.is_finite()) || !q.is_finite() {
+        return None;
+    }
+    Some((q / largest).normalize())
+}
+
+/// Unit direction of any finite non-zero `v` (scaled like [`normalized_rotation`]); `None` otherwise.
+pub fn normalized_direction(v: Vec3) -> Option<Vec3> {
+    let largest = v.abs().max_element();
+    if !(largest > 0.0 && largest.is_finite()) || !v.is_finite() {
+        return None;
+    }
+    Some((v / largest).normalize())
+}
+
 /// Unit direction of `v`, or `None` when it is too short to have one.
 #[inline]
 pub fn direction(v: Vec3) -> Option<Vec3> {
@@ -156,6 +175,20 @@ mod tests {
     fn shortest_arc_antiparallel_is_exact() {
         let q = shortest_arc(Vec3::Y, -Vec3::Y);
         assert!((q * Vec3::Y + Vec3::Y).length() < 1e-6);
+    }
+
+    #[test]
+    fn normalisation_accepts_any_finite_nonzero_input() {
+        let tiny = normalized_rotation(Quat::from_xyzw(0.0, 5e-7, 0.0, 5e-7)).unwrap();
+        let huge = normalized_rotation(Quat::from_xyzw(0.0, 1e20, 0.0, 1e20)).unwrap();
+        let denormal = normalized_rotation(Quat::from_xyzw(0.0, 0.0, 0.0, 1e-40)).unwrap();
+        assert!((tiny.length() - 1.0).abs() < 1e-6 && tiny.dot(huge) > 0.999_999);
+        assert_eq!(denormal, Quat::IDENTITY);
+        assert!(normalized_rotation(Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)).is_none());
+        assert!(normalized_rotation(Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0)).is_none());
+        assert_eq!(normalized_direction(Vec3::new(1e-20, 0.0, 0.0)), Some(Vec3::X));
+        assert_eq!(normalized_direction(Vec3::new(0.0, -3e38, 0.0)), Some(-Vec3::Y));
+        assert!(normalized_direction(Vec3::ZERO).is_none());
     }
 
     #[test]

@@ -7,7 +7,7 @@
 use glam::{Quat, Vec3};
 
 use super::error::{Error, Result};
-use super::math::{Transform, direction, shortest_arc};
+use super::math::{Transform, direction, normalized_rotation, shortest_arc};
 
 /// A validated shape: positions and unit orientations in the anchor frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,12 +32,11 @@ impl Shape {
             if !joint.is_finite() {
                 return Err(Error::invalid_argument(format!("joint {i} has a non-finite position or rotation")));
             }
-            let norm = joint.rotation.length();
-            if !(norm > 1e-6 && norm.is_finite()) {
+            let Some(rotation) = normalized_rotation(joint.rotation) else {
                 return Err(Error::invalid_argument(format!("joint {i} has a null rotation quaternion")));
-            }
+            };
             positions.push(joint.position);
-            orientations.push(joint.rotation / norm);
+            orientations.push(rotation);
         }
         let extent = positions.iter().map(|p| (*p - positions[0]).length()).fold(0.0f32, f32::max);
         for j in 0..positions.len() - 1 {

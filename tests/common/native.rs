@@ -1,5 +1,6 @@
-//! The shared library as C hosts load it. `cargo test` builds only the rlib, so the tests that need
-//! `libkodawari.so` build it themselves, with the same profile and target directory as the test binary.
+//! The shared library as C hosts load it. `cargo test` leaves `libkodawari.so` in `deps/` only when it
+//! happens to need it, so the tests that load it build it themselves (`cargo build --lib`), with the same
+//! profile and target directory as the test binary, and use the copy in `target/<profile>/`.
 
 use std::path::PathBuf;
 use std::process::Command;

@@ -1,0 +1,1725 @@
+/*
+ * Plain-C tests of the kodawari C ABI (include/kodawari.h), linked dynamically against the cdylib.
+ * Built and run by tests/c_harness.rs (`cargo test --test c_harness`), also under valgrind.
+ *
+ * Conventions: a test is `static int test_x(void)` returning 0 on success (see harness.h). Engines are
+ * created through engine_new(), which registers their destruction after the test so that a failing test
+ * does not leak. Everything is deterministic: no clocks, no random numbers.
+ */
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "kodawari.h"
+#include "harness.h"
+
+/* ---- ABI layout: every struct is padding-free and has the size the other language bindings assume ---- */
+
+_Static_assert(sizeof(kdw_vec3) == 12, "kdw_vec3 is 12 bytes");
+_Static_assert(sizeof(kdw_quat) == 16, "kdw_quat is 16 bytes");
+_Static_assert(sizeof(kdw_transform) == 28, "kdw_transform is 28 bytes");
+_Static_assert(sizeof(kdw_engine_def) == 40, "kdw_engine_def is 40 bytes");
+_Static_assert(sizeof(kdw_chain_def) == 32, "kdw_chain_def is 32 bytes");
+_Static_assert(sizeof(kdw_engine_stats) == 56, "kdw_engine_stats is 56 bytes");
+_Static_assert(sizeof(kdw_status) == 4, "kdw_status is int32_t");
+_Static_assert(sizeof(kdw_chain_id) == 8, "kdw_chain_id is uint64_t");
+_Static_assert(sizeof(kdw_view_shape_id) == 8, "kdw_view_shape_id is uint64_t");
+
+_Static_assert(offsetof(kdw_vec3, x) == 0 && offsetof(kdw_vec3, y) == 4 && offsetof(kdw_vec3, z) == 8,
+               "kdw_vec3 fields are packed");
+_Static_assert(offsetof(kdw_quat, x) == 0 && offsetof(kdw_quat, y) == 4 && offsetof(kdw_quat, z) == 8 &&
+                   offsetof(kdw_quat, w) == 12,
+               "kdw_quat is (x, y, z, w), packed");
+_Static_assert(offsetof(kdw_transform, position) == 0, "kdw_transform.position first");
+_Static_assert(offsetof(kdw_transform, rotation) == 12, "kdw_transform.rotation right after position");
+
+_Static_assert(offsetof(kdw_engine_def, struct_size) == 0, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, gravity) == 4, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, substep_rate) == 16, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, max_substeps) == 20, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, iterations) == 24, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, time_scale) == 28, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, teleport_distance) == 32, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, teleport_angle) == 36, "kdw_engine_def layout");
+
+_Static_assert(offsetof(kdw_chain_def, struct_size) == 0, "kdw_chain_def layout");
+_Static_assert(offsetof(kdw_chain_def, stiffness) == 4, "kdw_chain_def layout");
+_Static_assert(offsetof(kdw_chain_def, damping) == 8, "kdw_chain_def layout");
+_Static_assert(offsetof(kdw_chain_def, momentum_suppression) == 12, "kdw_chain_def layout");
+_Static_assert(offsetof(kdw_chain_def, mass) == 16, "kdw_chain_def layout");
+_Static_assert(offsetof(kdw_chain_def, radius) == 20, "kdw_chain_def layout");
+_Static_assert(offsetof(kdw_chain_def, gravity_scale) == 24, "kdw_chain_def layout");
+_Static_assert(offsetof(kdw_chain_def, anchor) == 28, "kdw_chain_def layout");
+
+_Static_assert(offsetof(kdw_engine_stats, struct_size) == 0, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, chain_count) == 4, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, joint_count) == 8, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, substeps_last_step) == 12, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, chains_asleep) == 16, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, reserved) == 20, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, substeps_total) == 24, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, solver_fallbacks) == 32, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, time_dropped) == 40, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, simulated_time) == 48, "kdw_engine_stats layout");
+
+/* ---- constants ------------------------------------------------------------------------------------------ */
+
+#define PI_F 3.14159265358979f
+#define FRAME_DT (1.0f / 60.0f)
+#define ORBIT_FRAMES 240
+
+#define MAX_JOINTS 16
+#define MAX_CHAINS 8
+#define MAX_TOTAL (MAX_JOINTS * MAX_CHAINS)
+
+/* Root joint vs anchor, relative to the root's distance from the world origin: float rounding of one rigid
+ * transform (a few ulps; measured 1.2e-7 m at 1.7 m). */
+#define ROOT_TOL_REL 1e-6
+/* Segment lengths, relative. */
+#define LENGTH_TOL 1e-4
+/* Unit length of returned quaternions. */
+#define UNIT_TOL 1e-5
+
+#define SENTINEL_U32 0xDEADBEEFu
+#define SENTINEL_U64 0xDEADBEEFCAFEF00Dull
+#define SENTINEL_BYTE 0xA5
+
+/* ---- small vector and quaternion helpers ------------------------------------------------------------------ */
+
+static kdw_vec3 v3(float x, float y, float z)
+{
+    kdw_vec3 v = {x, y, z};
+    return v;
+}
+
+static kdw_vec3 v_add(kdw_vec3 a, kdw_vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static kdw_vec3 v_sub(kdw_vec3 a, kdw_vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static kdw_vec3 v_scale(kdw_vec3 a, float s) { return v3(a.x * s, a.y * s, a.z * s); }
+static kdw_vec3 v_cross(kdw_vec3 a, kdw_vec3 b)
+{
+    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static double v_length(kdw_vec3 a) { return sqrt((double)a.x * a.x + (double)a.y * a.y + (double)a.z * a.z); }
+static double v_dist(kdw_vec3 a, kdw_vec3 b) { return v_length(v_sub(a, b)); }
+static kdw_vec3 v_normalize(kdw_vec3 a) { return v_scale(a, (float)(1.0 / v_length(a))); }
+static int v_is_finite(kdw_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+static kdw_quat q4(float x, float y, float z, float w)
+{
+    kdw_quat q = {x, y, z, w};
+    return q;
+}
+
+static kdw_quat q_identity(void) { return q4(0.0f, 0.0f, 0.0f, 1.0f); }
+
+/* Rotation by `angle` radians about the axis (x, y, z) (need not be unit). */
+static kdw_quat q_axis_angle(float x, float y, float z, float angle)
+{
+    float n = sqrtf(x * x + y * y + z * z);
+    float s = sinf(0.5f * angle) / n;
+    return q4(x * s, y * s, z * s, cosf(0.5f * angle));
+}
+
+static kdw_quat q_mul(kdw_quat a, kdw_quat b)
+{
+    return q4(a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y, a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+              a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w, a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z);
+}
+
+static kdw_quat q_conjugate(kdw_quat q) { return q4(-q.x, -q.y, -q.z, q.w); }
+static kdw_quat q_scale(kdw_quat q, float s) { return q4(q.x * s, q.y * s, q.z * s, q.w * s); }
+static double q_norm(kdw_quat q)
+{
+    return sqrt((double)q.x * q.x + (double)q.y * q.y + (double)q.z * q.z + (double)q.w * q.w);
+}
+static kdw_quat q_normalize(kdw_quat q) { return q_scale(q, (float)(1.0 / q_norm(q))); }
+static int q_is_finite(kdw_quat q) { return isfinite(q.x) && isfinite(q.y) && isfinite(q.z) && isfinite(q.w); }
+
+static kdw_vec3 q_rotate(kdw_quat q, kdw_vec3 v)
+{
+    kdw_vec3 u = v3(q.x, q.y, q.z);
+    kdw_vec3 t = v_scale(v_cross(u, v), 2.0f);
+    return v_add(v_add(v, v_scale(t, q.w)), v_cross(u, t));
+}
+
+/* Largest component difference of two rotations, sign-agnostic (q and -q are the same rotation). */
+static double q_distance(kdw_quat a, kdw_quat b)
+{
+    double plus = fmax(fmax(fabs((double)a.x - b.x), fabs((double)a.y - b.y)),
+                       fmax(fabs((double)a.z - b.z), fabs((double)a.w - b.w)));
+    double minus = fmax(fmax(fabs((double)a.x + b.x), fabs((double)a.y + b.y)),
+                        fmax(fabs((double)a.z + b.z), fabs((double)a.w + b.w)));
+    return fmin(plus, minus);
+}
+
+static kdw_transform xf(kdw_vec3 position, kdw_quat rotation)
+{
+    kdw_transform t = {position, rotation};
+    return t;
+}
+
+static int bytes_are(const void *data, size_t size, unsigned char value)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    for (size_t i = 0; i < size; ++i) {
+        if (p[i] != value) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* ---- chain shapes ------------------------------------------------------------------------------------- */
+
+typedef struct chain_spec {
+    uint32_t n;
+    kdw_transform joints[MAX_JOINTS];
+} chain_spec;
+
+/* The shapes every test uses (filled by init_shapes() before the first test). */
+static chain_spec g_ahoge;       /* 8 joints straight up from (0, 0.1, 0), 0.05 apart, identity rotations */
+static chain_spec g_ahoge_left;  /* the same chain bent toward -x */
+static chain_spec g_ahoge_right; /* the same chain bent toward +x */
+static chain_spec g_side_lock;   /* 5 joints hanging down from (0.08, 0, 0.02), 0.04 apart */
+static chain_spec g_tail;        /* 6 joints going down and back from (0, 0.05, -0.1), 0.06 apart */
+
+static void make_straight(chain_spec *s, uint32_t n, kdw_vec3 root, kdw_vec3 direction, float spacing)
+{
+    s->n = n;
+    for (uint32_t j = 0; j < n; ++j) {
+        s->joints[j] = xf(v_add(root, v_scale(direction, spacing * (float)j)), q_identity());
+    }
+}
+
+/* The ahoge, each segment turned `bend` radians further about +z than its parent: bend > 0 leans the
+ * chain toward -x, bend < 0 toward +x. Joint j is rotated like segment j (the tip like its parent). */
+static void make_ahoge_bent(chain_spec *s, float bend)
+{
+    s->n = 8;
+    kdw_vec3 p = v3(0.0f, 0.1f, 0.0f);
+    for (uint32_t j = 0; j < s->n; ++j) {
+        uint32_t segment = j + 1 < s->n ? j : j - 1;
+        float angle = bend * (float)(segment + 1);
+        s->joints[j] = xf(p, q_axis_angle(0.0f, 0.0f, 1.0f, angle));
+        p = v_add(p, v_scale(v3(-sinf(angle), cosf(angle), 0.0f), 0.05f));
+    }
+}
+
+static void init_shapes(void)
+{
+    make_straight(&g_ahoge, 8, v3(0.0f, 0.1f, 0.0f), v3(0.0f, 1.0f, 0.0f), 0.05f);
+    make_ahoge_bent(&g_ahoge_left, 0.15f);
+    make_ahoge_bent(&g_ahoge_right, -0.15f);
+    make_straight(&g_side_lock, 5, v3(0.08f, 0.0f, 0.02f), v3(0.0f, -1.0f, 0.0f), 0.04f);
+    make_straight(&g_tail, 6, v3(0.0f, 0.05f, -0.1f), v3(0.0f, -0.6f, -0.8f), 0.06f);
+}
+
+/* ---- scene ------------------------------------------------------------------------------------------------ */
+
+static kdw_transform head_at_rest(void) { return xf(v3(0.0f, 1.6f, 0.0f), q_identity()); }
+
+/* Camera orbiting the head: (3 cos a, 0.3, 3 sin a), a = 2 pi frame / 240. */
+static kdw_vec3 orbit_camera(int frame)
+{
+    float a = 2.0f * PI_F * (float)frame / (float)ORBIT_FRAMES;
+    return v3(3.0f * cosf(a), 0.3f, 3.0f * sinf(a));
+}
+
+static void destroy_engine_cleanup(void *engine) { (void)kdw_engine_destroy((kdw_engine *)engine); }
+
+/* Creates an engine that is destroyed after the current test (unless engine_free() is called first). */
+static kdw_engine *engine_new(const kdw_engine_def *def)
+{
+    kdw_engine *engine = NULL;
+    kdw_status status = kdw_engine_create(def, &engine);
+    if (status != KDW_STATUS_OK || engine == NULL) {
+        printf("    kdw_engine_create failed: %s (%s)\n", kdw_status_str(status), harness_last_error());
+        return NULL;
+    }
+    harness_defer(destroy_engine_cleanup, engine);
+    return engine;
+}
+
+static kdw_engine *engine_new_default(void)
+{
+    kdw_engine_def def = kdw_engine_def_default();
+    return engine_new(&def);
+}
+
+static kdw_status engine_free(kdw_engine *engine)
+{
+    harness_cancel(engine);
+    return kdw_engine_destroy(engine);
+}
+
+/* Three view-reference chains (ahoge, side lock, tail) and, optionally, two view shapes on the ahoge. */
+typedef struct scene {
+    kdw_engine *engine;
+    kdw_chain_id chains[3];
+    kdw_view_shape_id left, right;
+} scene;
+
+static const chain_spec *const g_scene_specs[3] = {&g_ahoge, &g_side_lock, &g_tail};
+
+static int scene_build(scene *s, int with_view_shapes)
+{
+    memset(s, 0, sizeof *s);
+    s->engine = engine_new_default();
+    ENSURE(s->engine != NULL);
+    kdw_chain_def def = kdw_chain_def_default();
+    for (int i = 0; i < 3; ++i) {
+        ENSURE_OK(kdw_chain_create(s->engine, &def, g_scene_specs[i]->joints, g_scene_specs[i]->n, &s->chains[i]));
+        ENSURE(s->chains[i] != 0);
+    }
+    if (with_view_shapes) {
+        kdw_vec3 left = v3(-1.0f, 0.0f, 0.0f);
+        kdw_vec3 right = v3(1.0f, 0.0f, 0.0f);
+        ENSURE_OK(kdw_chain_add_view_shape(s->engine, s->chains[0], &left, g_ahoge_left.joints, g_ahoge_left.n,
+                                           1.0f, &s->left));
+        ENSURE_OK(kdw_chain_add_view_shape(s->engine, s->chains[0], &right, g_ahoge_right.joints,
+                                           g_ahoge_right.n, 2.0f, &s->right));
+        ENSURE(s->left != 0 && s->right != 0 && s->left != s->right);
+    }
+    return 0;
+}
+
+static int step_orbit(kdw_engine *engine, int frame, const kdw_transform *head)
+{
+    kdw_vec3 camera = orbit_camera(frame);
+    ENSURE_OK(kdw_engine_step(engine, FRAME_DT, &camera, head));
+    return 0;
+}
+
+static int step_frames(kdw_engine *engine, int first, int count)
+{
+    kdw_transform head = head_at_rest();
+    for (int frame = first; frame < first + count; ++frame) {
+        ENSURE(step_orbit(engine, frame, &head) == 0);
+    }
+    return 0;
+}
+
+static uint64_t hash_of(const kdw_engine *engine)
+{
+    uint64_t hash = 0;
+    if (kdw_engine_state_hash(engine, &hash) != KDW_STATUS_OK) {
+        printf("    kdw_engine_state_hash failed: %s\n", harness_last_error());
+        return 0;
+    }
+    return hash;
+}
+
+/* ---- pose checks ------------------------------------------------------------------------------------------ */
+
+/* Where the last check_pose failure happened (for the report). */
+static int g_pose_chain = -1;
+static int g_pose_joint = -1;
+
+/*
+ * Reads everything back through the batched calls and checks, for chain i (creation order) with base
+ * shape specs[i] and world anchor anchors[i] (rotation need not be unit):
+ * finite; root joint at anchor * base joint 0; segment lengths of the base within LENGTH_TOL relative;
+ * world and local rotations unit within UNIT_TOL; skinning-ready rotations (each joint's bone axis,
+ * taken from the base shape, points at the next joint); local rotations compose to the world ones
+ * (anchor * local_0 * local_1 ...); and kdw_chain_read_world equal to the batched read.
+ */
+static int check_pose(const kdw_engine *engine, const chain_spec *const specs[], const kdw_transform anchors[],
+                      uint32_t chain_count)
+{
+    g_pose_chain = -1;
+    g_pose_joint = -1;
+    uint32_t count = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_chain_count(engine, &count));
+    ENSURE(count == chain_count && count <= MAX_CHAINS);
+    uint32_t expected_joints = 0;
+    for (uint32_t i = 0; i < chain_count; ++i) {
+        expected_joints += specs[i]->n;
+    }
+    uint32_t joints = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_joint_count(engine, &joints));
+    ENSURE(joints == expected_joints && joints <= MAX_TOTAL);
+
+    kdw_transform world[MAX_TOTAL];
+    kdw_quat local[MAX_TOTAL];
+    kdw_chain_id ids[MAX_CHAINS];
+    uint32_t written = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_read_world(engine, world, joints, &written));
+    ENSURE(written == joints);
+    written = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_read_local_rotations(engine, local, joints, &written));
+    ENSURE(written == joints);
+    written = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_get_chain_ids(engine, ids, MAX_CHAINS, &written));
+    ENSURE(written == chain_count);
+
+    uint32_t offset = 0;
+    for (uint32_t i = 0; i < chain_count; ++i) {
+        g_pose_chain = (int)i;
+        g_pose_joint = -1;
+        const chain_spec *s = specs[i];
+        const kdw_transform *w = world + offset;
+        const kdw_quat *l = local + offset;
+        kdw_quat anchor_rotation = q_normalize(anchors[i].rotation);
+
+        uint32_t n = SENTINEL_U32;
+        ENSURE_OK(kdw_chain_joint_count(engine, ids[i], &n));
+        ENSURE(n == s->n);
+        kdw_transform own[MAX_JOINTS];
+        written = SENTINEL_U32;
+        ENSURE_OK(kdw_chain_read_world(engine, ids[i], own, MAX_JOINTS, &written));
+        ENSURE(written == n);
+        ENSURE(memcmp(own, w, n * sizeof *w) == 0);
+
+        for (uint32_t j = 0; j < n; ++j) {
+            g_pose_joint = (int)j;
+            ENSURE(v_is_finite(w[j].position) && q_is_finite(w[j].rotation) && q_is_finite(l[j]));
+            ENSURE_SMALL(q_norm(w[j].rotation) - 1.0, UNIT_TOL);
+            ENSURE_SMALL(q_norm(l[j]) - 1.0, UNIT_TOL);
+        }
+
+        g_pose_joint = 0;
+        kdw_vec3 expected_root = v_add(anchors[i].position, q_rotate(anchor_rotation, s->joints[0].position));
+        ENSURE_SMALL(v_dist(w[0].position, expected_root), ROOT_TOL_REL * (1.0 + v_length(expected_root)));
+
+        for (uint32_t j = 0; j + 1 < n; ++j) {
+            g_pose_joint = (int)j;
+            kdw_vec3 base_segment = v_sub(s->joints[j + 1].position, s->joints[j].position);
+            double rest = v_length(base_segment);
+            kdw_vec3 segment = v_sub(w[j + 1].position, w[j].position);
+            ENSURE_SMALL(v_length(segment) / rest - 1.0, LENGTH_TOL);
+            /* Skinning-ready: the bone axis (base segment in the base joint's frame) points at the next joint,
+             * up to the direction error float positions allow (a few ulps of |position| over the length). */
+            kdw_vec3 axis = v_normalize(q_rotate(q_conjugate(q_normalize(s->joints[j].rotation)), base_segment));
+            double position_ulp = 1.2e-7 * (1.0 + v_length(w[j].position));
+            ENSURE_SMALL(v_dist(q_rotate(w[j].rotation, axis), v_normalize(segment)), 1e-5 + 4.0 * position_ulp / rest);
+        }
+
+        kdw_quat parent = anchor_rotation;
+        for (uint32_t j = 0; j < n; ++j) {
+            g_pose_joint = (int)j;
+            ENSURE_SMALL(q_distance(q_mul(parent, l[j]), w[j].rotation), 1e-5);
+            parent = w[j].rotation;
+        }
+        offset += n;
+    }
+    g_pose_chain = -1;
+    g_pose_joint = -1;
+    return 0;
+}
+
+#define ENSURE_POSE(engine, specs, anchors, count, frame)                                                   \
+    do {                                                                                                   \
+        if (check_pose((engine), (specs), (anchors), (count)) != 0) {                                      \
+            printf("    (pose check at frame %d, chain %d, joint %d)\n", (int)(frame), g_pose_chain,       \
+                   g_pose_joint);                                                                          \
+            return 1;                                                                                      \
+        }                                                                                                  \
+    } while (0)
+
+/* ---- rejected calls ----------------------------------------------------------------------------------- */
+
+static char g_primed_message[256];
+
+/* Makes the thread's last error message a known one, so that the next failure can be seen to replace it. */
+static int prime_error_message(void)
+{
+    kdw_engine_def def = kdw_engine_def_default();
+    def.struct_size = 0xC0FFEEu;
+    kdw_engine *engine = NULL;
+    kdw_status status = kdw_engine_create(&def, &engine);
+    if (engine != NULL) {
+        (void)kdw_engine_destroy(engine);
+    }
+    ENSURE(status == KDW_STATUS_STRUCT_SIZE_MISMATCH && engine == NULL);
+    uint32_t length = 0;
+    ENSURE_OK(kdw_last_error_message(g_primed_message, (uint32_t)sizeof g_primed_message, &length));
+    ENSURE(length > 0 && strlen(g_primed_message) == length);
+    return 0;
+}
+
+/* The last error message is non-empty, consistent with its length, and not the primed one. */
+static int error_message_is_fresh(void)
+{
+    char message[512];
+    uint32_t length = SENTINEL_U32;
+    ENSURE_OK(kdw_last_error_message(message, (uint32_t)sizeof message, &length));
+    ENSURE(length > 0 && length == strlen(message));
+    if (strcmp(message, g_primed_message) == 0) {
+        printf("    the failing call did not set its own error message (still \"%s\")\n", message);
+        return 1;
+    }
+    return 0;
+}
+
+/*
+ * `call` must fail with `expected`, set a fresh non-empty error message, and leave `engine` bit-identical
+ * (kdw_engine_state_hash unchanged). `engine` is the engine the call targets, or a witness engine when the
+ * call targets none (NULL engine, kdw_engine_create).
+ */
+#define ENSURE_REJECTED(engine, call, expected)                                                             \
+    do {                                                                                                   \
+        uint64_t rejected_before_ = 0, rejected_after_ = 0;                                                \
+        ENSURE_OK(kdw_engine_state_hash((engine), &rejected_before_));                                     \
+        ENSURE(prime_error_message() == 0);                                                                \
+        ENSURE_STATUS(call, expected);                                                                     \
+        if (error_message_is_fresh() != 0) {                                                               \
+            printf("%s:%d: after %s\n", __FILE__, __LINE__, #call);                                        \
+            return 1;                                                                                      \
+        }                                                                                                  \
+        ENSURE_OK(kdw_engine_state_hash((engine), &rejected_after_));                                      \
+        if (rejected_before_ != rejected_after_) {                                                         \
+            printf("%s:%d: rejected call changed the engine state: %s\n", __FILE__, __LINE__, #call);       \
+            return 1;                                                                                      \
+        }                                                                                                  \
+    } while (0)
+
+/* ================================================================================================== */
+/* Tests                                                                                              */
+/* ================================================================================================== */
+
+/* Must run first: no call has failed on this thread yet. */
+static int test_last_error_initially_empty(void)
+{
+    uint32_t length = SENTINEL_U32;
+    ENSURE_OK(kdw_last_error_message(NULL, 0, &length));
+    ENSURE(length == 0);
+    char buffer[8];
+    memset(buffer, 'x', sizeof buffer);
+    length = SENTINEL_U32;
+    ENSURE_OK(kdw_last_error_message(buffer, (uint32_t)sizeof buffer, &length));
+    ENSURE(length == 0 && buffer[0] == '\0');
+    return 0;
+}
+
+static int test_layout(void)
+{
+    kdw_engine_def engine_def = kdw_engine_def_default();
+    kdw_chain_def chain_def = kdw_chain_def_default();
+    ENSURE(engine_def.struct_size == sizeof(kdw_engine_def));
+    ENSURE(chain_def.struct_size == sizeof(kdw_chain_def));
+
+    kdw_engine *engine = engine_new(&engine_def);
+    ENSURE(engine != NULL);
+    kdw_engine_stats stats;
+    memset(&stats, SENTINEL_BYTE, sizeof stats);
+    ENSURE_OK(kdw_engine_get_stats(engine, &stats));
+    ENSURE(stats.struct_size == sizeof(kdw_engine_stats));
+    ENSURE(stats.reserved == 0);
+    ENSURE(stats.chain_count == 0 && stats.joint_count == 0 && stats.substeps_total == 0);
+    ENSURE(stats.simulated_time == 0.0 && stats.time_dropped == 0.0);
+    ENSURE_OK(engine_free(engine));
+    return 0;
+}
+
+static int test_version(void)
+{
+    ENSURE(kdw_abi_version() == KDW_ABI_VERSION);
+    const char *version = kdw_version_string();
+    ENSURE(version != NULL && version[0] != '\0');
+    ENSURE(strchr(version, '.') != NULL);
+
+    const kdw_status known[] = {KDW_STATUS_OK,
+                                KDW_STATUS_NULL_POINTER,
+                                KDW_STATUS_INVALID_ID,
+                                KDW_STATUS_INVALID_ARGUMENT,
+                                KDW_STATUS_BUFFER_TOO_SMALL,
+                                KDW_STATUS_CAPACITY_EXCEEDED,
+                                KDW_STATUS_STRUCT_SIZE_MISMATCH,
+                                KDW_STATUS_PANIC};
+    const size_t count = sizeof known / sizeof known[0];
+    const char *unknown = kdw_status_str(12345);
+    ENSURE(unknown != NULL && unknown[0] != '\0');
+    for (size_t i = 0; i < count; ++i) {
+        const char *text = kdw_status_str(known[i]);
+        ENSURE(text != NULL && text[0] != '\0');
+        ENSURE(strcmp(text, unknown) != 0);
+        for (size_t j = 0; j < i; ++j) {
+            ENSURE(strcmp(text, kdw_status_str(known[j])) != 0);
+        }
+    }
+    const kdw_status unknowns[] = {1, -7, -99, -101, 12345, INT32_MIN, INT32_MAX};
+    for (size_t i = 0; i < sizeof unknowns / sizeof unknowns[0]; ++i) {
+        const char *text = kdw_status_str(unknowns[i]);
+        ENSURE(text != NULL && strcmp(text, unknown) == 0);
+    }
+    return 0;
+}
+
+static int test_defaults_and_settings(void)
+{
+    kdw_engine_def def = kdw_engine_def_default();
+    ENSURE(def.gravity.x == 0.0f && def.gravity.y == -9.81f && def.gravity.z == 0.0f);
+    ENSURE(def.substep_rate == 240.0f && def.max_substeps == 16 && def.iterations == 2);
+    ENSURE(def.time_scale == 1.0f && def.teleport_distance == 1.0f);
+    ENSURE_SMALL(def.teleport_angle - 0.5f * PI_F, 1e-6);
+
+    kdw_chain_def chain = kdw_chain_def_default();
+    ENSURE(chain.stiffness == 0.5f && chain.damping == 1.0f && chain.momentum_suppression == 1.0f);
+    ENSURE(chain.mass == 1.0f && chain.radius == 0.02f && chain.gravity_scale == 1.0f);
+    ENSURE(chain.anchor == KDW_ANCHOR_VIEW_REFERENCE);
+
+    kdw_engine *engine = engine_new(&def);
+    ENSURE(engine != NULL);
+    kdw_engine_def got;
+    memset(&got, SENTINEL_BYTE, sizeof got);
+    ENSURE_OK(kdw_engine_get_def(engine, &got));
+    ENSURE(memcmp(&got, &def, sizeof def) == 0);
+
+    kdw_engine_def changed = def;
+    changed.iterations = 4;
+    changed.substep_rate = 120.0f;
+    changed.gravity = v3(0.0f, -1.62f, 0.0f);
+    ENSURE_OK(kdw_engine_set_def(engine, &changed));
+    ENSURE_OK(kdw_engine_get_def(engine, &got));
+    ENSURE(memcmp(&got, &changed, sizeof got) == 0);
+
+    kdw_vec3 gravity = v3(1.0f, -3.0f, 0.5f);
+    ENSURE_OK(kdw_engine_set_gravity(engine, &gravity));
+    ENSURE_OK(kdw_engine_get_def(engine, &got));
+    ENSURE(got.gravity.x == 1.0f && got.gravity.y == -3.0f && got.gravity.z == 0.5f);
+    ENSURE(got.iterations == 4 && got.substep_rate == 120.0f);
+
+    kdw_chain_id id = 0;
+    ENSURE_OK(kdw_chain_create(engine, &chain, g_tail.joints, g_tail.n, &id));
+    kdw_chain_def chain_got;
+    memset(&chain_got, SENTINEL_BYTE, sizeof chain_got);
+    ENSURE_OK(kdw_chain_get_def(engine, id, &chain_got));
+    ENSURE(memcmp(&chain_got, &chain, sizeof chain) == 0);
+    kdw_chain_def stiffer = chain;
+    stiffer.stiffness = 0.9f;
+    stiffer.damping = 3.0f;
+    stiffer.gravity_scale = -0.5f;
+    stiffer.anchor = KDW_ANCHOR_OWN;
+    ENSURE_OK(kdw_chain_set_def(engine, id, &stiffer));
+    ENSURE_OK(kdw_chain_get_def(engine, id, &chain_got));
+    ENSURE(memcmp(&chain_got, &stiffer, sizeof chain_got) == 0);
+    return 0;
+}
+
+/* The full life cycle through the C ABI with three chains and two view shapes. */
+static int test_life_cycle(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    kdw_engine *engine = s.engine;
+    ENSURE(s.chains[0] != s.chains[1] && s.chains[1] != s.chains[2] && s.chains[0] != s.chains[2]);
+    ENSURE(s.left != s.chains[0] && s.left != s.chains[1] && s.left != s.chains[2]);
+
+    uint32_t count = SENTINEL_U32;
+    ENSURE_OK(kdw_chain_view_shape_count(engine, s.chains[0], &count));
+    ENSURE(count == 2);
+    ENSURE_OK(kdw_chain_view_shape_count(engine, s.chains[1], &count));
+    ENSURE(count == 0);
+    ENSURE_OK(kdw_engine_chain_count(engine, &count));
+    ENSURE(count == 3);
+    ENSURE_OK(kdw_engine_joint_count(engine, &count));
+    ENSURE(count == 8 + 5 + 6);
+    for (int i = 0; i < 3; ++i) {
+        uint32_t valid = SENTINEL_U32;
+        ENSURE_OK(kdw_chain_is_valid(engine, s.chains[i], &valid));
+        ENSURE(valid == 1);
+    }
+
+    const kdw_transform head = head_at_rest();
+    const kdw_transform anchors[3] = {head, head, head};
+    for (int frame = 0; frame < ORBIT_FRAMES; ++frame) {
+        ENSURE(step_orbit(engine, frame, &head) == 0);
+        ENSURE_POSE(engine, g_scene_specs, anchors, 3, frame);
+
+        if (frame == 0 || frame == ORBIT_FRAMES / 2) {
+            /* Camera on +x (frame 0) or -x (frame 120): the rest shape is (mostly) the matching view shape. */
+            kdw_transform rest[MAX_JOINTS];
+            uint32_t written = SENTINEL_U32;
+            ENSURE_OK(kdw_chain_read_rest_shape(engine, s.chains[0], rest, MAX_JOINTS, &written));
+            ENSURE(written == g_ahoge.n);
+            ENSURE_SMALL(v_dist(rest[0].position, g_ahoge.joints[0].position), 1e-6);
+            for (uint32_t j = 0; j + 1 < written; ++j) {
+                ENSURE_SMALL(v_dist(rest[j + 1].position, rest[j].position) / 0.05 - 1.0, 1e-5);
+            }
+            float tip_x = rest[written - 1].position.x;
+            if (frame == 0) {
+                ENSURE(tip_x > 0.1f); /* the +x shape's tip is at x = +0.189 */
+            } else {
+                ENSURE(tip_x < -0.1f); /* the -x shape's tip is at x = -0.189 */
+            }
+        }
+    }
+
+    kdw_engine_stats stats;
+    memset(&stats, SENTINEL_BYTE, sizeof stats);
+    ENSURE_OK(kdw_engine_get_stats(engine, &stats));
+    ENSURE(stats.struct_size == sizeof stats);
+    ENSURE(stats.chain_count == 3);
+    ENSURE(stats.joint_count == 19);
+    ENSURE(stats.substeps_last_step == 4);
+    ENSURE(stats.substeps_total == (uint64_t)ORBIT_FRAMES * 4u);
+    ENSURE(stats.chains_asleep <= stats.chain_count);
+    ENSURE(stats.reserved == 0);
+    ENSURE(stats.solver_fallbacks == 0);
+    ENSURE(stats.time_dropped == 0.0);
+    ENSURE_SMALL(stats.simulated_time - ORBIT_FRAMES * (double)FRAME_DT, 1e-9);
+
+    kdw_chain_id ids[MAX_CHAINS];
+    uint32_t written = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_get_chain_ids(engine, ids, MAX_CHAINS, &written));
+    ENSURE(written == 3);
+    ENSURE(ids[0] == s.chains[0] && ids[1] == s.chains[1] && ids[2] == s.chains[2]);
+    ENSURE_OK(kdw_engine_get_chain_ids(engine, ids, 3, &written));
+    ENSURE(written == 3);
+
+    for (int i = 0; i < 3; ++i) {
+        float energy = -1.0f;
+        ENSURE_OK(kdw_chain_kinetic_energy(engine, s.chains[i], &energy));
+        ENSURE(isfinite(energy) && energy >= 0.0f);
+        kdw_chain_def def;
+        ENSURE_OK(kdw_chain_get_def(engine, s.chains[i], &def));
+        kdw_chain_def expected = kdw_chain_def_default();
+        ENSURE(memcmp(&def, &expected, sizeof def) == 0);
+    }
+
+    /* Remove one view shape: the chain keeps the other; the removed id goes stale. */
+    uint64_t before = hash_of(engine);
+    ENSURE_OK(kdw_view_shape_remove(engine, s.right));
+    ENSURE(hash_of(engine) != before);
+    ENSURE_OK(kdw_chain_view_shape_count(engine, s.chains[0], &count));
+    ENSURE(count == 1);
+    ENSURE_REJECTED(engine, kdw_view_shape_remove(engine, s.right), KDW_STATUS_INVALID_ID);
+    ENSURE_REJECTED(engine, kdw_view_shape_set_influence(engine, s.right, 1.0f), KDW_STATUS_INVALID_ID);
+    ENSURE_OK(kdw_view_shape_set_influence(engine, s.left, 3.0f));
+
+    /* Destroy the first chain: the others keep their order and their pose. */
+    kdw_transform world_before[MAX_TOTAL];
+    ENSURE_OK(kdw_engine_read_world(engine, world_before, MAX_TOTAL, &written));
+    ENSURE(written == 19);
+    ENSURE_OK(kdw_chain_destroy(engine, s.chains[0]));
+    ENSURE_OK(kdw_engine_chain_count(engine, &count));
+    ENSURE(count == 2);
+    ENSURE_OK(kdw_engine_joint_count(engine, &count));
+    ENSURE(count == 11);
+    ENSURE_OK(kdw_engine_get_stats(engine, &stats));
+    ENSURE(stats.chain_count == 2 && stats.joint_count == 11);
+    uint32_t valid = SENTINEL_U32;
+    ENSURE_OK(kdw_chain_is_valid(engine, s.chains[0], &valid));
+    ENSURE(valid == 0);
+    ENSURE_REJECTED(engine, kdw_view_shape_remove(engine, s.left), KDW_STATUS_INVALID_ID);
+    ENSURE_OK(kdw_engine_get_chain_ids(engine, ids, MAX_CHAINS, &written));
+    ENSURE(written == 2 && ids[0] == s.chains[1] && ids[1] == s.chains[2]);
+    kdw_transform world_after[MAX_TOTAL];
+    ENSURE_OK(kdw_engine_read_world(engine, world_after, MAX_TOTAL, &written));
+    ENSURE(written == 11);
+    ENSURE(memcmp(world_after, world_before + 8, 11 * sizeof(kdw_transform)) == 0);
+
+    /* A new chain (reusing the freed slot) comes last in the batched order; the old id stays stale. */
+    kdw_chain_def def = kdw_chain_def_default();
+    kdw_chain_id again = 0;
+    ENSURE_OK(kdw_chain_create(engine, &def, g_ahoge.joints, g_ahoge.n, &again));
+    ENSURE(again != 0 && again != s.chains[0]);
+    ENSURE_OK(kdw_chain_is_valid(engine, s.chains[0], &valid));
+    ENSURE(valid == 0);
+    ENSURE_OK(kdw_engine_get_chain_ids(engine, ids, MAX_CHAINS, &written));
+    ENSURE(written == 3 && ids[0] == s.chains[1] && ids[1] == s.chains[2] && ids[2] == again);
+    const chain_spec *const reordered[3] = {&g_side_lock, &g_tail, &g_ahoge};
+    for (int frame = 0; frame < 30; ++frame) {
+        ENSURE(step_orbit(engine, frame, &head) == 0);
+        ENSURE_POSE(engine, reordered, anchors, 3, frame);
+    }
+
+    /* Resets are accepted and change the state (chains are re-placed at the next step). */
+    before = hash_of(engine);
+    ENSURE_OK(kdw_engine_reset(engine));
+    ENSURE(hash_of(engine) != before);
+    ENSURE(step_frames(engine, 0, 1) == 0);
+    ENSURE_OK(kdw_chain_reset(engine, again));
+    ENSURE(step_frames(engine, 1, 1) == 0);
+    ENSURE_POSE(engine, reordered, anchors, 3, 1);
+
+    ENSURE_OK(kdw_chain_destroy(engine, s.chains[1]));
+    ENSURE_OK(kdw_chain_destroy(engine, s.chains[2]));
+    ENSURE_OK(kdw_chain_destroy(engine, again));
+    ENSURE_OK(kdw_engine_chain_count(engine, &count));
+    ENSURE(count == 0);
+    ENSURE_OK(engine_free(engine));
+    return 0;
+}
+
+/* The simulated chain follows the view: a stiff ahoge leans to the side the camera sees it from. (With the
+ * default stiffness 0.5 this 0.35 m standing chain buckles under gravity, so this test stiffens it.) */
+static int test_view_dependence(void)
+{
+    kdw_engine *engine = engine_new_default();
+    ENSURE(engine != NULL);
+    kdw_chain_def def = kdw_chain_def_default();
+    def.stiffness = 0.9f;
+    kdw_chain_id id = 0;
+    kdw_view_shape_id left = 0, right = 0;
+    const kdw_vec3 from_left = v3(-1.0f, 0.0f, 0.0f), from_right = v3(1.0f, 0.0f, 0.0f);
+    ENSURE_OK(kdw_chain_create(engine, &def, g_ahoge.joints, g_ahoge.n, &id));
+    ENSURE_OK(kdw_chain_add_view_shape(engine, id, &from_left, g_ahoge_left.joints, 8, 1.0f, &left));
+    ENSURE_OK(kdw_chain_add_view_shape(engine, id, &from_right, g_ahoge_right.joints, 8, 2.0f, &right));
+    const kdw_transform head = head_at_rest();
+    for (int frame = 0; frame < ORBIT_FRAMES; ++frame) {
+        ENSURE(step_orbit(engine, frame, &head) == 0);
+        kdw_transform world[MAX_JOINTS];
+        uint32_t written = 0;
+        ENSURE_OK(kdw_chain_read_world(engine, id, world, MAX_JOINTS, &written));
+        ENSURE(written == 8);
+        kdw_vec3 tip = v_sub(world[7].position, head.position);
+        ENSURE(tip.y > 0.3f); /* stands up: the root is at 0.1, the straight tip at 0.45 */
+        ENSURE_SMALL(tip.z, 1e-4); /* every shape lies in the xy plane */
+        if (frame == 0 || frame == ORBIT_FRAMES - 1) {
+            ENSURE(tip.x > 0.1f); /* seen from +x */
+        }
+        if (frame == ORBIT_FRAMES / 2) {
+            ENSURE(tip.x < -0.1f); /* seen from -x */
+        }
+    }
+    return 0;
+}
+
+/* Chains anchored to their own bones, moved with kdw_engine_set_anchors. */
+static int test_own_anchors(void)
+{
+    kdw_engine *engine = engine_new_default();
+    ENSURE(engine != NULL);
+    kdw_chain_def own = kdw_chain_def_default();
+    own.anchor = KDW_ANCHOR_OWN;
+    kdw_chain_def follow = kdw_chain_def_default();
+    kdw_chain_id a = 0, b = 0, c = 0;
+    ENSURE_OK(kdw_chain_create(engine, &own, g_side_lock.joints, g_side_lock.n, &a));
+    ENSURE_OK(kdw_chain_create(engine, &follow, g_ahoge.joints, g_ahoge.n, &b));
+    ENSURE_OK(kdw_chain_create(engine, &own, g_tail.joints, g_tail.n, &c));
+    const chain_spec *const specs[3] = {&g_side_lock, &g_ahoge, &g_tail};
+
+    const kdw_transform head = head_at_rest();
+    kdw_transform anchors[4];
+    for (int i = 0; i < 4; ++i) {
+        anchors[i] = xf(v3(0.3f, 1.0f, 0.0f), q_identity());
+    }
+    /* count must equal the chain count (3) */
+    ENSURE_REJECTED(engine, kdw_engine_set_anchors(engine, anchors, 2), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_REJECTED(engine, kdw_engine_set_anchors(engine, anchors, 4), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_REJECTED(engine, kdw_engine_set_anchors(engine, anchors, 0), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_REJECTED(engine, kdw_engine_set_anchors(engine, NULL, 3), KDW_STATUS_NULL_POINTER);
+    /* every entry is validated, also those of view-reference chains */
+    anchors[1].position.y = NAN;
+    ENSURE_REJECTED(engine, kdw_engine_set_anchors(engine, anchors, 3), KDW_STATUS_INVALID_ARGUMENT);
+    anchors[1].position.y = 1.0f;
+    anchors[2].rotation = q4(0.0f, 0.0f, 0.0f, 0.0f);
+    ENSURE_REJECTED(engine, kdw_engine_set_anchors(engine, anchors, 3), KDW_STATUS_INVALID_ARGUMENT);
+    anchors[2].rotation = q4(0.0f, INFINITY, 0.0f, 1.0f);
+    ENSURE_REJECTED(engine, kdw_engine_set_anchors(engine, anchors, 3), KDW_STATUS_INVALID_ARGUMENT);
+
+    const int frames = 120;
+    for (int frame = 0; frame < frames; ++frame) {
+        float b_angle = 2.0f * PI_F * (float)frame / (float)frames;
+        /* A hand moving on a circle and swinging; a hip bobbing and turning. Rotations deliberately not unit. */
+        kdw_transform hand = xf(v3(0.3f * cosf(b_angle), 1.0f + 0.1f * sinf(2.0f * b_angle), 0.3f * sinf(b_angle)),
+                                q_scale(q_axis_angle(0.0f, 0.0f, 1.0f, 0.6f * sinf(b_angle)), 2.0f));
+        kdw_transform unused = xf(v3(5.0f, 5.0f, 5.0f), q_axis_angle(1.0f, 0.0f, 0.0f, 1.0f));
+        kdw_transform hip = xf(v3(0.0f, 0.9f + 0.05f * sinf(3.0f * b_angle), -0.05f),
+                               q_scale(q_axis_angle(0.0f, 1.0f, 0.0f, 0.5f * sinf(b_angle)), 0.5f));
+        kdw_transform set[3] = {hand, unused, hip};
+        ENSURE_OK(kdw_engine_set_anchors(engine, set, 3));
+        ENSURE(step_orbit(engine, frame, &head) == 0);
+        /* The view-reference chain ignores its entry and follows the head. */
+        kdw_transform expected[3] = {hand, head, hip};
+        ENSURE_POSE(engine, specs, expected, 3, frame);
+    }
+
+    /* An engine without chains takes zero anchors. */
+    kdw_engine *empty = engine_new_default();
+    ENSURE(empty != NULL);
+    ENSURE_OK(kdw_engine_set_anchors(empty, NULL, 0));
+    ENSURE_REJECTED(empty, kdw_engine_set_anchors(empty, anchors, 1), KDW_STATUS_INVALID_ARGUMENT);
+    return 0;
+}
+
+static int test_engine_without_chains(void)
+{
+    kdw_engine *engine = engine_new_default();
+    ENSURE(engine != NULL);
+    uint32_t written = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_read_world(engine, NULL, 0, &written));
+    ENSURE(written == 0);
+    written = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_read_local_rotations(engine, NULL, 0, &written));
+    ENSURE(written == 0);
+    written = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_get_chain_ids(engine, NULL, 0, &written));
+    ENSURE(written == 0);
+    ENSURE(step_frames(engine, 0, 3) == 0);
+    kdw_engine_stats stats;
+    ENSURE_OK(kdw_engine_get_stats(engine, &stats));
+    ENSURE(stats.chain_count == 0 && stats.joint_count == 0 && stats.substeps_total == 12);
+    ENSURE_OK(kdw_engine_reset(engine));
+    return 0;
+}
+
+/* Fixed substeps: the cap drops time and counts it; time_scale 0 pauses. */
+static int test_substep_clock(void)
+{
+    kdw_engine *engine = engine_new_default();
+    ENSURE(engine != NULL);
+    kdw_chain_def def = kdw_chain_def_default();
+    kdw_chain_id id = 0;
+    ENSURE_OK(kdw_chain_create(engine, &def, g_tail.joints, g_tail.n, &id));
+    kdw_transform head = head_at_rest();
+    kdw_vec3 camera = v3(0.0f, 1.6f, 3.0f);
+
+    ENSURE_OK(kdw_engine_step(engine, 1.0f, &camera, &head));
+    kdw_engine_stats stats;
+    ENSURE_OK(kdw_engine_get_stats(engine, &stats));
+    ENSURE(stats.substeps_last_step == 16 && stats.substeps_total == 16);
+    ENSURE_SMALL(stats.time_dropped - (1.0 - 16.0 / 240.0), 1e-9);
+    ENSURE_SMALL(stats.simulated_time - 1.0, 1e-9);
+
+    ENSURE_OK(kdw_engine_step(engine, FRAME_DT, &camera, &head));
+    ENSURE_OK(kdw_engine_get_stats(engine, &stats));
+    ENSURE(stats.substeps_last_step == 4 && stats.substeps_total == 20);
+
+    kdw_engine_def paused = kdw_engine_def_default();
+    paused.time_scale = 0.0f;
+    ENSURE_OK(kdw_engine_set_def(engine, &paused));
+    kdw_transform before[MAX_JOINTS], after[MAX_JOINTS];
+    uint32_t written = 0;
+    ENSURE_OK(kdw_chain_read_world(engine, id, before, MAX_JOINTS, &written));
+    ENSURE_OK(kdw_engine_step(engine, FRAME_DT, &camera, &head));
+    ENSURE_OK(kdw_engine_get_stats(engine, &stats));
+    ENSURE(stats.substeps_last_step == 0 && stats.substeps_total == 20);
+    ENSURE_OK(kdw_chain_read_world(engine, id, after, MAX_JOINTS, &written));
+    ENSURE(memcmp(before, after, written * sizeof before[0]) == 0);
+
+    kdw_engine_def slow = kdw_engine_def_default();
+    slow.substep_rate = 60.0f;
+    ENSURE_OK(kdw_engine_set_def(engine, &slow));
+    ENSURE_OK(kdw_engine_step(engine, FRAME_DT, &camera, &head));
+    ENSURE_OK(kdw_engine_get_stats(engine, &stats));
+    ENSURE(stats.substeps_last_step == 1 && stats.substeps_total == 21);
+    return 0;
+}
+
+/* Same calls, same results: state hash and read-back bit-identical across two engines. */
+static int determinism_case(int with_view_shapes)
+{
+    scene a, b;
+    ENSURE(scene_build(&a, with_view_shapes) == 0);
+    ENSURE(scene_build(&b, with_view_shapes) == 0);
+    ENSURE(step_frames(a.engine, 0, 120) == 0);
+    ENSURE(step_frames(b.engine, 0, 120) == 0);
+
+    kdw_transform world_a[MAX_TOTAL], world_b[MAX_TOTAL];
+    kdw_quat local_a[MAX_TOTAL], local_b[MAX_TOTAL];
+    uint32_t na = 0, nb = 0;
+    ENSURE_OK(kdw_engine_read_world(a.engine, world_a, MAX_TOTAL, &na));
+    ENSURE_OK(kdw_engine_read_world(b.engine, world_b, MAX_TOTAL, &nb));
+    ENSURE(na == 19 && nb == 19);
+    ENSURE(memcmp(world_a, world_b, na * sizeof world_a[0]) == 0);
+    ENSURE_OK(kdw_engine_read_local_rotations(a.engine, local_a, MAX_TOTAL, &na));
+    ENSURE_OK(kdw_engine_read_local_rotations(b.engine, local_b, MAX_TOTAL, &nb));
+    ENSURE(memcmp(local_a, local_b, na * sizeof local_a[0]) == 0);
+
+    /* Ids differ between the engines (they carry the engine's salt); the hash must not depend on them. */
+    ENSURE(a.chains[0] != b.chains[0]);
+    ENSURE(hash_of(a.engine) == hash_of(b.engine));
+
+    /* One more step on one engine only: the hashes part; the same step on the other joins them again. */
+    ENSURE(step_frames(a.engine, 120, 1) == 0);
+    ENSURE(hash_of(a.engine) != hash_of(b.engine));
+    ENSURE_OK(kdw_engine_read_world(a.engine, world_a, MAX_TOTAL, &na));
+    ENSURE(memcmp(world_a, world_b, na * sizeof world_a[0]) != 0);
+    ENSURE(step_frames(b.engine, 120, 1) == 0);
+    ENSURE(hash_of(a.engine) == hash_of(b.engine));
+    ENSURE_OK(kdw_engine_read_world(b.engine, world_b, MAX_TOTAL, &nb));
+    ENSURE(memcmp(world_a, world_b, na * sizeof world_a[0]) == 0);
+    return 0;
+}
+
+static int test_determinism_without_view_shapes(void) { return determinism_case(0); }
+static int test_determinism_with_view_shapes(void) { return determinism_case(1); }
+
+/* Edge cases of the anchor and camera: a camera sitting on the view reference (no view direction), a teleport
+ * (far jump and half turn in one step), and a new base shape whose segment lengths the chain takes on. */
+static int test_teleport_camera_on_head_and_new_base(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    kdw_engine *e = s.engine;
+    ENSURE(step_frames(e, 0, 30) == 0);
+
+    kdw_transform head = head_at_rest();
+    kdw_transform anchors[3] = {head, head, head};
+    for (int frame = 0; frame < 10; ++frame) {
+        ENSURE_OK(kdw_engine_step(e, FRAME_DT, &head.position, &head));
+        ENSURE_POSE(e, g_scene_specs, anchors, 3, frame);
+    }
+
+    /* 5.7 m away (the teleport distance is 1 m; close enough to the origin for 1e-4 relative float lengths) */
+    kdw_transform far = xf(v3(4.0f, 1.6f, -3.0f), q_axis_angle(0.0f, 1.0f, 0.0f, 3.0f));
+    kdw_vec3 camera = v_add(far.position, v3(0.0f, 0.3f, 3.0f));
+    for (int i = 0; i < 3; ++i) {
+        anchors[i] = far;
+    }
+    for (int frame = 0; frame < 30; ++frame) {
+        ENSURE_OK(kdw_engine_step(e, FRAME_DT, &camera, &far));
+        ENSURE_POSE(e, g_scene_specs, anchors, 3, frame);
+    }
+    kdw_engine_stats stats;
+    ENSURE_OK(kdw_engine_get_stats(e, &stats));
+    ENSURE(stats.substeps_total == 70u * 4u);
+
+    /* the side lock gets 0.05 m segments instead of 0.04 */
+    chain_spec longer;
+    make_straight(&longer, 5, v3(0.08f, 0.0f, 0.02f), v3(0.0f, -1.0f, 0.0f), 0.05f);
+    ENSURE_OK(kdw_chain_set_base_shape(e, s.chains[1], longer.joints, longer.n));
+    const chain_spec *const specs[3] = {&g_ahoge, &longer, &g_tail};
+    for (int frame = 0; frame < 30; ++frame) {
+        ENSURE_OK(kdw_engine_step(e, FRAME_DT, &camera, &far));
+        ENSURE_POSE(e, specs, anchors, 3, frame);
+    }
+    kdw_transform rest[MAX_JOINTS];
+    uint32_t written = 0;
+    ENSURE_OK(kdw_chain_read_rest_shape(e, s.chains[1], rest, MAX_JOINTS, &written));
+    ENSURE(written == 5);
+    for (uint32_t j = 0; j < written; ++j) {
+        ENSURE_SMALL(v_dist(rest[j].position, longer.joints[j].position), 1e-6);
+    }
+    return 0;
+}
+
+/* dt == 0 changes nothing, whatever camera and view reference come with it. */
+static int test_dt_zero_changes_nothing(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    kdw_transform elsewhere = xf(v3(1.0f, 2.0f, 3.0f), q_axis_angle(0.0f, 1.0f, 0.0f, 1.0f));
+    kdw_vec3 camera = v3(-4.0f, 0.0f, 2.0f);
+
+    /* on a fresh engine (nothing placed yet) */
+    uint64_t before = hash_of(s.engine);
+    ENSURE_OK(kdw_engine_step(s.engine, 0.0f, &camera, &elsewhere));
+    ENSURE(hash_of(s.engine) == before);
+
+    ENSURE(step_frames(s.engine, 0, 30) == 0);
+    before = hash_of(s.engine);
+    kdw_transform world_before[MAX_TOTAL], world_after[MAX_TOTAL];
+    uint32_t written = 0;
+    ENSURE_OK(kdw_engine_read_world(s.engine, world_before, MAX_TOTAL, &written));
+    kdw_engine_stats stats_before, stats_after;
+    ENSURE_OK(kdw_engine_get_stats(s.engine, &stats_before));
+
+    ENSURE_OK(kdw_engine_step(s.engine, 0.0f, &camera, &elsewhere));
+    ENSURE(hash_of(s.engine) == before);
+    ENSURE_OK(kdw_engine_step(s.engine, -0.0f, &camera, &elsewhere));
+    ENSURE(hash_of(s.engine) == before);
+    ENSURE_OK(kdw_engine_read_world(s.engine, world_after, MAX_TOTAL, &written));
+    ENSURE(memcmp(world_before, world_after, written * sizeof world_before[0]) == 0);
+    ENSURE_OK(kdw_engine_get_stats(s.engine, &stats_after));
+    ENSURE(stats_after.substeps_total == stats_before.substeps_total);
+    ENSURE(stats_after.simulated_time == stats_before.simulated_time);
+    return 0;
+}
+
+/* A view reference quaternion need not be unit: 3q acts exactly like q. */
+static int test_non_unit_view_reference(void)
+{
+    scene unit, scaled;
+    ENSURE(scene_build(&unit, 1) == 0);
+    ENSURE(scene_build(&scaled, 1) == 0);
+    const chain_spec *const specs[3] = {&g_ahoge, &g_side_lock, &g_tail};
+    for (int frame = 0; frame < 120; ++frame) {
+        float t = (float)frame / 120.0f;
+        kdw_quat q = q_mul(q_axis_angle(0.0f, 1.0f, 0.0f, 0.8f * sinf(2.0f * PI_F * t)),
+                           q_axis_angle(1.0f, 0.0f, 0.0f, 0.2f));
+        kdw_transform head = xf(v3(0.1f * t, 1.6f, 0.0f), q);
+        kdw_transform head3 = xf(head.position, q_scale(q, 3.0f));
+        kdw_vec3 camera = orbit_camera(frame);
+        ENSURE_OK(kdw_engine_step(unit.engine, FRAME_DT, &camera, &head));
+        ENSURE_OK(kdw_engine_step(scaled.engine, FRAME_DT, &camera, &head3));
+        const kdw_transform anchors[3] = {head, head, head};
+        ENSURE_POSE(scaled.engine, specs, anchors, 3, frame);
+    }
+    kdw_transform a[MAX_TOTAL], b[MAX_TOTAL];
+    uint32_t na = 0, nb = 0;
+    ENSURE_OK(kdw_engine_read_world(unit.engine, a, MAX_TOTAL, &na));
+    ENSURE_OK(kdw_engine_read_world(scaled.engine, b, MAX_TOTAL, &nb));
+    ENSURE(na == nb && na == 19);
+    for (uint32_t j = 0; j < na; ++j) {
+        ENSURE_SMALL(v_dist(a[j].position, b[j].position), 1e-5);
+        ENSURE_SMALL(q_distance(a[j].rotation, b[j].rotation), 1e-5);
+    }
+    return 0;
+}
+
+/* ---- error paths ---------------------------------------------------------------------------------------- */
+
+static int test_error_null_engine(void)
+{
+    scene s; /* a witness: no call below may touch it */
+    ENSURE(scene_build(&s, 1) == 0);
+    kdw_engine *w = s.engine;
+    const kdw_chain_id chain = s.chains[0];
+    const kdw_view_shape_id view = s.left;
+    const kdw_chain_def chain_def = kdw_chain_def_default();
+    const kdw_engine_def engine_def = kdw_engine_def_default();
+    const kdw_transform head = head_at_rest();
+    const kdw_vec3 camera = v3(3.0f, 0.3f, 0.0f);
+    const kdw_vec3 direction = v3(0.0f, 0.0f, 1.0f);
+    const kdw_vec3 gravity = v3(0.0f, -1.0f, 0.0f);
+    const kdw_transform anchors[3] = {head, head, head};
+
+    uint32_t u = SENTINEL_U32;
+    float f = -1.0f;
+    uint64_t h = SENTINEL_U64;
+    kdw_chain_id id_out = SENTINEL_U64;
+    kdw_view_shape_id view_out = SENTINEL_U64;
+    kdw_chain_def chain_def_out;
+    kdw_engine_def engine_def_out;
+    kdw_engine_stats stats_out;
+    kdw_transform transforms[MAX_TOTAL];
+    kdw_quat quats[MAX_TOTAL];
+    kdw_chain_id ids[MAX_CHAINS];
+    memset(&chain_def_out, SENTINEL_BYTE, sizeof chain_def_out);
+    memset(&engine_def_out, SENTINEL_BYTE, sizeof engine_def_out);
+    memset(&stats_out, SENTINEL_BYTE, sizeof stats_out);
+    memset(transforms, SENTINEL_BYTE, sizeof transforms);
+    memset(quats, SENTINEL_BYTE, sizeof quats);
+    memset(ids, SENTINEL_BYTE, sizeof ids);
+
+    const kdw_status NP = KDW_STATUS_NULL_POINTER;
+    ENSURE_REJECTED(w, kdw_chain_create(NULL, &chain_def, g_ahoge.joints, g_ahoge.n, &id_out), NP);
+    ENSURE_REJECTED(w, kdw_chain_destroy(NULL, chain), NP);
+    ENSURE_REJECTED(w, kdw_chain_is_valid(NULL, chain, &u), NP);
+    ENSURE_REJECTED(w, kdw_chain_get_def(NULL, chain, &chain_def_out), NP);
+    ENSURE_REJECTED(w, kdw_chain_set_def(NULL, chain, &chain_def), NP);
+    ENSURE_REJECTED(w, kdw_chain_set_base_shape(NULL, chain, g_ahoge.joints, g_ahoge.n), NP);
+    ENSURE_REJECTED(w, kdw_chain_reset(NULL, chain), NP);
+    ENSURE_REJECTED(w, kdw_chain_joint_count(NULL, chain, &u), NP);
+    ENSURE_REJECTED(w, kdw_chain_read_world(NULL, chain, transforms, MAX_TOTAL, &u), NP);
+    ENSURE_REJECTED(w, kdw_chain_read_rest_shape(NULL, chain, transforms, MAX_TOTAL, &u), NP);
+    ENSURE_REJECTED(w, kdw_chain_kinetic_energy(NULL, chain, &f), NP);
+    ENSURE_REJECTED(w, kdw_engine_destroy(NULL), NP);
+    ENSURE_REJECTED(w, kdw_engine_get_def(NULL, &engine_def_out), NP);
+    ENSURE_REJECTED(w, kdw_engine_set_def(NULL, &engine_def), NP);
+    ENSURE_REJECTED(w, kdw_engine_set_gravity(NULL, &gravity), NP);
+    ENSURE_REJECTED(w, kdw_engine_step(NULL, FRAME_DT, &camera, &head), NP);
+    ENSURE_REJECTED(w, kdw_engine_set_anchors(NULL, anchors, 3), NP);
+    ENSURE_REJECTED(w, kdw_engine_chain_count(NULL, &u), NP);
+    ENSURE_REJECTED(w, kdw_engine_joint_count(NULL, &u), NP);
+    ENSURE_REJECTED(w, kdw_engine_get_chain_ids(NULL, ids, MAX_CHAINS, &u), NP);
+    ENSURE_REJECTED(w, kdw_engine_read_world(NULL, transforms, MAX_TOTAL, &u), NP);
+    ENSURE_REJECTED(w, kdw_engine_read_local_rotations(NULL, quats, MAX_TOTAL, &u), NP);
+    ENSURE_REJECTED(w, kdw_engine_get_stats(NULL, &stats_out), NP);
+    ENSURE_REJECTED(w, kdw_engine_reset(NULL), NP);
+    ENSURE_REJECTED(w, kdw_engine_state_hash(NULL, &h), NP);
+    ENSURE_REJECTED(w, kdw_chain_add_view_shape(NULL, chain, &direction, g_ahoge.joints, g_ahoge.n, 1.0f, &view_out),
+                    NP);
+    ENSURE_REJECTED(w, kdw_view_shape_set_influence(NULL, view, 2.0f), NP);
+    ENSURE_REJECTED(w, kdw_view_shape_set_direction(NULL, view, &direction), NP);
+    ENSURE_REJECTED(w, kdw_view_shape_set_joints(NULL, view, g_ahoge.joints, g_ahoge.n), NP);
+    ENSURE_REJECTED(w, kdw_view_shape_remove(NULL, view), NP);
+    ENSURE_REJECTED(w, kdw_chain_view_shape_count(NULL, chain, &u), NP);
+
+    /* outputs are written only on success */
+    ENSURE(u == SENTINEL_U32 && f == -1.0f && h == SENTINEL_U64);
+    ENSURE(id_out == SENTINEL_U64 && view_out == SENTINEL_U64);
+    ENSURE(bytes_are(&chain_def_out, sizeof chain_def_out, SENTINEL_BYTE));
+    ENSURE(bytes_are(&engine_def_out, sizeof engine_def_out, SENTINEL_BYTE));
+    ENSURE(bytes_are(&stats_out, sizeof stats_out, SENTINEL_BYTE));
+    ENSURE(bytes_are(transforms, sizeof transforms, SENTINEL_BYTE));
+    ENSURE(bytes_are(quats, sizeof quats, SENTINEL_BYTE));
+    ENSURE(bytes_are(ids, sizeof ids, SENTINEL_BYTE));
+    return 0;
+}
+
+static int test_error_null_out_pointers(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_chain_id chain = s.chains[0];
+    const kdw_chain_def chain_def = kdw_chain_def_default();
+    const kdw_engine_def engine_def = kdw_engine_def_default();
+    const kdw_vec3 direction = v3(0.0f, 0.0f, 1.0f);
+    uint32_t u = SENTINEL_U32;
+    kdw_transform transforms[MAX_TOTAL];
+    kdw_quat quats[MAX_TOTAL];
+    kdw_chain_id ids[MAX_CHAINS];
+    memset(transforms, SENTINEL_BYTE, sizeof transforms);
+    memset(quats, SENTINEL_BYTE, sizeof quats);
+    memset(ids, SENTINEL_BYTE, sizeof ids);
+    const kdw_status NP = KDW_STATUS_NULL_POINTER;
+
+    ENSURE_REJECTED(e, kdw_engine_create(&engine_def, NULL), NP); /* and no engine leaks (valgrind) */
+    ENSURE_REJECTED(e, kdw_chain_create(e, &chain_def, g_tail.joints, g_tail.n, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_is_valid(e, chain, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_get_def(e, chain, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_joint_count(e, chain, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_read_world(e, chain, NULL, MAX_TOTAL, &u), NP);
+    ENSURE_REJECTED(e, kdw_chain_read_world(e, chain, transforms, MAX_TOTAL, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_read_rest_shape(e, chain, NULL, MAX_TOTAL, &u), NP);
+    ENSURE_REJECTED(e, kdw_chain_read_rest_shape(e, chain, transforms, MAX_TOTAL, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_kinetic_energy(e, chain, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_get_def(e, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_chain_count(e, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_joint_count(e, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_get_chain_ids(e, NULL, MAX_CHAINS, &u), NP);
+    ENSURE_REJECTED(e, kdw_engine_get_chain_ids(e, ids, MAX_CHAINS, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_read_world(e, NULL, MAX_TOTAL, &u), NP);
+    ENSURE_REJECTED(e, kdw_engine_read_world(e, transforms, MAX_TOTAL, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_read_local_rotations(e, NULL, MAX_TOTAL, &u), NP);
+    ENSURE_REJECTED(e, kdw_engine_read_local_rotations(e, quats, MAX_TOTAL, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_get_stats(e, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_state_hash(e, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &direction, g_ahoge.joints, g_ahoge.n, 1.0f, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_view_shape_count(e, chain, NULL), NP);
+
+    ENSURE(u == SENTINEL_U32);
+    ENSURE(bytes_are(transforms, sizeof transforms, SENTINEL_BYTE));
+    ENSURE(bytes_are(quats, sizeof quats, SENTINEL_BYTE));
+    ENSURE(bytes_are(ids, sizeof ids, SENTINEL_BYTE));
+    ENSURE_OK(kdw_engine_chain_count(e, &u));
+    ENSURE(u == 3);
+    ENSURE_OK(kdw_chain_view_shape_count(e, chain, &u));
+    ENSURE(u == 2);
+    return 0;
+}
+
+static int test_error_null_inputs(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    ENSURE(step_frames(s.engine, 0, 5) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_chain_id chain = s.chains[0];
+    const kdw_chain_def chain_def = kdw_chain_def_default();
+    const kdw_transform head = head_at_rest();
+    const kdw_vec3 camera = v3(3.0f, 0.3f, 0.0f);
+    const kdw_vec3 direction = v3(0.0f, 0.0f, 1.0f);
+    kdw_engine *engine_out = (kdw_engine *)(void *)&s; /* any non-NULL marker */
+    kdw_chain_id id_out = SENTINEL_U64;
+    kdw_view_shape_id view_out = SENTINEL_U64;
+    const kdw_status NP = KDW_STATUS_NULL_POINTER;
+
+    ENSURE_REJECTED(e, kdw_engine_create(NULL, &engine_out), NP);
+    ENSURE(engine_out == (kdw_engine *)(void *)&s);
+    ENSURE_REJECTED(e, kdw_engine_set_def(e, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_set_gravity(e, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_create(e, NULL, g_tail.joints, g_tail.n, &id_out), NP);
+    ENSURE_REJECTED(e, kdw_chain_create(e, &chain_def, NULL, g_tail.n, &id_out), NP);
+    ENSURE_REJECTED(e, kdw_chain_set_def(e, chain, NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_set_base_shape(e, chain, NULL, g_ahoge.n), NP);
+    ENSURE_REJECTED(e, kdw_engine_step(e, FRAME_DT, NULL, &head), NP);
+    ENSURE_REJECTED(e, kdw_engine_step(e, FRAME_DT, &camera, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_step(e, FRAME_DT, NULL, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_set_anchors(e, NULL, 3), NP);
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, NULL, g_ahoge.joints, g_ahoge.n, 1.0f, &view_out), NP);
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &direction, NULL, g_ahoge.n, 1.0f, &view_out), NP);
+    ENSURE_REJECTED(e, kdw_view_shape_set_direction(e, s.left, NULL), NP);
+    ENSURE_REJECTED(e, kdw_view_shape_set_joints(e, s.left, NULL, g_ahoge.n), NP);
+    ENSURE(id_out == SENTINEL_U64 && view_out == SENTINEL_U64);
+    return 0;
+}
+
+/* Every chain-id taking call rejects `bad`; kdw_chain_is_valid answers 0 for it. */
+static int check_bad_chain_id(kdw_engine *e, kdw_chain_id bad)
+{
+    const kdw_chain_def chain_def = kdw_chain_def_default();
+    const kdw_vec3 direction = v3(0.0f, 0.0f, 1.0f);
+    const kdw_status ID = KDW_STATUS_INVALID_ID;
+    uint32_t u = SENTINEL_U32;
+    float f = -1.0f;
+    kdw_view_shape_id view_out = SENTINEL_U64;
+    kdw_chain_def def_out;
+    kdw_transform transforms[MAX_JOINTS];
+    memset(&def_out, SENTINEL_BYTE, sizeof def_out);
+    memset(transforms, SENTINEL_BYTE, sizeof transforms);
+
+    ENSURE_OK(kdw_chain_is_valid(e, bad, &u));
+    ENSURE(u == 0);
+    u = SENTINEL_U32;
+    ENSURE_REJECTED(e, kdw_chain_destroy(e, bad), ID);
+    ENSURE_REJECTED(e, kdw_chain_get_def(e, bad, &def_out), ID);
+    ENSURE_REJECTED(e, kdw_chain_set_def(e, bad, &chain_def), ID);
+    ENSURE_REJECTED(e, kdw_chain_set_base_shape(e, bad, g_ahoge.joints, g_ahoge.n), ID);
+    ENSURE_REJECTED(e, kdw_chain_reset(e, bad), ID);
+    ENSURE_REJECTED(e, kdw_chain_joint_count(e, bad, &u), ID);
+    ENSURE_REJECTED(e, kdw_chain_read_world(e, bad, transforms, MAX_JOINTS, &u), ID);
+    ENSURE_REJECTED(e, kdw_chain_read_rest_shape(e, bad, transforms, MAX_JOINTS, &u), ID);
+    ENSURE_REJECTED(e, kdw_chain_kinetic_energy(e, bad, &f), ID);
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, bad, &direction, g_ahoge.joints, g_ahoge.n, 1.0f, &view_out), ID);
+    ENSURE_REJECTED(e, kdw_chain_view_shape_count(e, bad, &u), ID);
+    ENSURE(u == SENTINEL_U32 && f == -1.0f && view_out == SENTINEL_U64);
+    ENSURE(bytes_are(&def_out, sizeof def_out, SENTINEL_BYTE));
+    ENSURE(bytes_are(transforms, sizeof transforms, SENTINEL_BYTE));
+    return 0;
+}
+
+/* Every view-shape-id taking call rejects `bad`. */
+static int check_bad_view_shape_id(kdw_engine *e, kdw_view_shape_id bad)
+{
+    const kdw_vec3 direction = v3(0.0f, 0.0f, 1.0f);
+    const kdw_status ID = KDW_STATUS_INVALID_ID;
+    ENSURE_REJECTED(e, kdw_view_shape_set_influence(e, bad, 2.0f), ID);
+    ENSURE_REJECTED(e, kdw_view_shape_set_direction(e, bad, &direction), ID);
+    ENSURE_REJECTED(e, kdw_view_shape_set_joints(e, bad, g_ahoge_left.joints, g_ahoge_left.n), ID);
+    ENSURE_REJECTED(e, kdw_view_shape_remove(e, bad), ID);
+    return 0;
+}
+
+static int test_error_ids(void)
+{
+    scene a, b;
+    ENSURE(scene_build(&a, 1) == 0);
+    ENSURE(scene_build(&b, 1) == 0);
+    ENSURE(step_frames(a.engine, 0, 5) == 0);
+    kdw_engine *e = a.engine;
+    const kdw_chain_def def = kdw_chain_def_default();
+    const kdw_vec3 direction = v3(0.0f, 0.0f, -1.0f);
+
+    /* stale ids: a destroyed chain (also after its slot is reused) and a removed view shape */
+    kdw_chain_id stale = 0, reused = 0;
+    kdw_view_shape_id stale_view = 0, orphan_view = 0;
+    ENSURE_OK(kdw_chain_create(e, &def, g_ahoge.joints, g_ahoge.n, &stale));
+    ENSURE_OK(kdw_chain_add_view_shape(e, stale, &direction, g_ahoge_left.joints, g_ahoge_left.n, 1.0f,
+                                       &orphan_view));
+    ENSURE_OK(kdw_chain_add_view_shape(e, a.chains[1], &direction, g_side_lock.joints, g_side_lock.n, 1.0f,
+                                       &stale_view));
+    ENSURE_OK(kdw_view_shape_remove(e, stale_view));
+    ENSURE_OK(kdw_chain_destroy(e, stale));
+
+    ENSURE(check_bad_chain_id(e, 0) == 0);                         /* null */
+    ENSURE(check_bad_chain_id(e, stale) == 0);                     /* stale */
+    ENSURE(check_bad_chain_id(e, b.chains[0]) == 0);               /* foreign */
+    ENSURE(check_bad_chain_id(e, a.left) == 0);                    /* a view-shape id */
+    ENSURE(check_bad_chain_id(e, 0x123456789ABCDEF0ull) == 0);     /* garbage */
+    ENSURE(check_bad_chain_id(e, UINT64_MAX) == 0);                /* garbage */
+    ENSURE(check_bad_view_shape_id(e, 0) == 0);                    /* null */
+    ENSURE(check_bad_view_shape_id(e, stale_view) == 0);           /* removed */
+    ENSURE(check_bad_view_shape_id(e, orphan_view) == 0);          /* its chain was destroyed */
+    ENSURE(check_bad_view_shape_id(e, b.left) == 0);               /* foreign */
+    ENSURE(check_bad_view_shape_id(e, a.chains[0]) == 0);          /* a chain id */
+
+    ENSURE_OK(kdw_chain_create(e, &def, g_ahoge.joints, g_ahoge.n, &reused));
+    ENSURE(reused != stale);
+    ENSURE(check_bad_chain_id(e, stale) == 0);             /* still stale with its slot in use again */
+    ENSURE(check_bad_view_shape_id(e, orphan_view) == 0);  /* and so are its view shapes */
+    kdw_view_shape_id fresh_view = 0;
+    ENSURE_OK(kdw_chain_add_view_shape(e, reused, &direction, g_ahoge_left.joints, g_ahoge_left.n, 1.0f, &fresh_view));
+    ENSURE(fresh_view != orphan_view && fresh_view != stale_view);
+    ENSURE(check_bad_view_shape_id(e, orphan_view) == 0);
+    ENSURE(check_bad_view_shape_id(e, stale_view) == 0);
+
+    /* the foreign ids are fine on their own engine, and b was not touched */
+    uint32_t valid = SENTINEL_U32;
+    ENSURE_OK(kdw_chain_is_valid(b.engine, b.chains[0], &valid));
+    ENSURE(valid == 1);
+    ENSURE_OK(kdw_view_shape_set_influence(b.engine, b.left, 1.5f));
+    return 0;
+}
+
+static int test_error_step_inputs(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    ENSURE(step_frames(s.engine, 0, 10) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_transform head = head_at_rest();
+    const kdw_vec3 camera = orbit_camera(10);
+    const kdw_status IA = KDW_STATUS_INVALID_ARGUMENT;
+    kdw_engine_stats before, after;
+    ENSURE_OK(kdw_engine_get_stats(e, &before));
+
+    ENSURE_REJECTED(e, kdw_engine_step(e, NAN, &camera, &head), IA);
+    ENSURE_REJECTED(e, kdw_engine_step(e, INFINITY, &camera, &head), IA);
+    ENSURE_REJECTED(e, kdw_engine_step(e, -INFINITY, &camera, &head), IA);
+    ENSURE_REJECTED(e, kdw_engine_step(e, -FRAME_DT, &camera, &head), IA);
+    ENSURE_REJECTED(e, kdw_engine_step(e, -1e-30f, &camera, &head), IA);
+
+    const kdw_vec3 bad_cameras[] = {v3(NAN, 0.3f, 3.0f), v3(3.0f, INFINITY, 0.0f), v3(3.0f, 0.3f, -INFINITY)};
+    for (size_t i = 0; i < sizeof bad_cameras / sizeof bad_cameras[0]; ++i) {
+        ENSURE_REJECTED(e, kdw_engine_step(e, FRAME_DT, &bad_cameras[i], &head), IA);
+    }
+
+    kdw_transform bad_heads[8];
+    for (int i = 0; i < 8; ++i) {
+        bad_heads[i] = head;
+    }
+    bad_heads[0].position.x = NAN;
+    bad_heads[1].position.y = INFINITY;
+    bad_heads[2].position.z = -INFINITY;
+    bad_heads[3].rotation.w = NAN;
+    bad_heads[4].rotation.x = INFINITY;
+    bad_heads[5].rotation = q4(0.0f, 0.0f, 0.0f, 0.0f);
+    bad_heads[6].rotation = q4(NAN, NAN, NAN, NAN);
+    bad_heads[7].rotation = q4(0.0f, -0.0f, 0.0f, -0.0f);
+    for (int i = 0; i < 8; ++i) {
+        ENSURE_REJECTED(e, kdw_engine_step(e, FRAME_DT, &camera, &bad_heads[i]), IA);
+    }
+
+    ENSURE_OK(kdw_engine_get_stats(e, &after));
+    ENSURE(after.substeps_total == before.substeps_total && after.simulated_time == before.simulated_time);
+    /* and the engine still works */
+    ENSURE(step_frames(e, 10, 1) == 0);
+    return 0;
+}
+
+static int test_error_chain_shapes(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    ENSURE(step_frames(s.engine, 0, 5) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_chain_def def = kdw_chain_def_default();
+    const kdw_status IA = KDW_STATUS_INVALID_ARGUMENT;
+    kdw_chain_id id_out = SENTINEL_U64;
+
+    /* too few joints */
+    ENSURE_REJECTED(e, kdw_chain_create(e, &def, g_ahoge.joints, 0, &id_out), IA);
+    ENSURE_REJECTED(e, kdw_chain_create(e, &def, NULL, 0, &id_out), IA);
+    ENSURE_REJECTED(e, kdw_chain_create(e, &def, g_ahoge.joints, 1, &id_out), IA);
+
+    /* broken shapes, each at create and as a new base shape of a live chain */
+    chain_spec bad[7];
+    for (int i = 0; i < 7; ++i) {
+        bad[i] = g_ahoge;
+    }
+    bad[0].joints[3].position = bad[0].joints[2].position;  /* zero-length segment */
+    bad[1].joints[1].position = bad[1].joints[0].position;  /* zero-length first segment */
+    bad[2].joints[3].position.x = NAN;                      /* NaN position */
+    bad[3].joints[7].position.y = INFINITY;                 /* Inf position */
+    bad[4].joints[2].rotation.z = NAN;                      /* NaN rotation */
+    bad[5].joints[5].rotation = q4(0.0f, 0.0f, 0.0f, 0.0f); /* null quaternion */
+    bad[6].joints[0].rotation.w = -INFINITY;                /* Inf rotation */
+    for (int i = 0; i < 7; ++i) {
+        ENSURE_REJECTED(e, kdw_chain_create(e, &def, bad[i].joints, bad[i].n, &id_out), IA);
+        ENSURE_REJECTED(e, kdw_chain_set_base_shape(e, s.chains[0], bad[i].joints, bad[i].n), IA);
+    }
+    /* a new base shape must keep the joint count */
+    ENSURE_REJECTED(e, kdw_chain_set_base_shape(e, s.chains[0], g_ahoge.joints, g_ahoge.n - 1), IA);
+    ENSURE_REJECTED(e, kdw_chain_set_base_shape(e, s.chains[1], g_ahoge.joints, g_ahoge.n), IA);
+    ENSURE_REJECTED(e, kdw_chain_set_base_shape(e, s.chains[0], g_ahoge.joints, 0), IA);
+
+    ENSURE(id_out == SENTINEL_U64);
+    uint32_t count = 0;
+    ENSURE_OK(kdw_engine_chain_count(e, &count));
+    ENSURE(count == 3);
+    /* a valid replacement base is accepted */
+    ENSURE_OK(kdw_chain_set_base_shape(e, s.chains[0], g_ahoge_right.joints, g_ahoge_right.n));
+    return 0;
+}
+
+static int test_error_view_shapes(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    ENSURE(step_frames(s.engine, 0, 5) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_chain_id chain = s.chains[0];
+    const kdw_status IA = KDW_STATUS_INVALID_ARGUMENT;
+    const kdw_vec3 good = v3(0.0f, 0.0f, 1.0f);
+    kdw_view_shape_id out = SENTINEL_U64;
+    const chain_spec *j = &g_ahoge_left;
+
+    /* wrong joint count */
+    chain_spec longer = *j;
+    longer.n = j->n + 1;
+    longer.joints[j->n] = xf(v_add(j->joints[j->n - 1].position, v3(0.0f, 0.05f, 0.0f)), q_identity());
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &good, j->joints, j->n - 1, 1.0f, &out), IA);
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &good, longer.joints, longer.n, 1.0f, &out), IA);
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &good, NULL, 0, 1.0f, &out), IA);
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, s.chains[1], &good, j->joints, j->n, 1.0f, &out), IA);
+    ENSURE_REJECTED(e, kdw_view_shape_set_joints(e, s.left, j->joints, j->n - 1), IA);
+    ENSURE_REJECTED(e, kdw_view_shape_set_joints(e, s.left, longer.joints, longer.n), IA);
+
+    /* broken joints */
+    chain_spec zero = *j, nan_joint = *j;
+    zero.joints[4].position = zero.joints[5].position;
+    nan_joint.joints[6].rotation.y = NAN;
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &good, zero.joints, zero.n, 1.0f, &out), IA);
+    ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &good, nan_joint.joints, nan_joint.n, 1.0f, &out), IA);
+    ENSURE_REJECTED(e, kdw_view_shape_set_joints(e, s.left, zero.joints, zero.n), IA);
+    ENSURE_REJECTED(e, kdw_view_shape_set_joints(e, s.left, nan_joint.joints, nan_joint.n), IA);
+
+    /* bad directions */
+    const kdw_vec3 bad_directions[] = {v3(0.0f, 0.0f, 0.0f), v3(NAN, 0.0f, 1.0f), v3(0.0f, INFINITY, 0.0f),
+                                       v3(-INFINITY, 0.0f, 0.0f)};
+    for (size_t i = 0; i < sizeof bad_directions / sizeof bad_directions[0]; ++i) {
+        ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &bad_directions[i], j->joints, j->n, 1.0f, &out), IA);
+        ENSURE_REJECTED(e, kdw_view_shape_set_direction(e, s.left, &bad_directions[i]), IA);
+    }
+
+    /* bad influences */
+    const float bad_influences[] = {0.0f, -0.0f, -1.0f, NAN, INFINITY, -INFINITY};
+    for (size_t i = 0; i < sizeof bad_influences / sizeof bad_influences[0]; ++i) {
+        ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &good, j->joints, j->n, bad_influences[i], &out), IA);
+        ENSURE_REJECTED(e, kdw_view_shape_set_influence(e, s.left, bad_influences[i]), IA);
+    }
+
+    ENSURE(out == SENTINEL_U64);
+    uint32_t count = 0;
+    ENSURE_OK(kdw_chain_view_shape_count(e, chain, &count));
+    ENSURE(count == 2);
+    /* the valid versions are accepted */
+    const kdw_vec3 tiny_but_fine = v3(0.0f, 1e-3f, 0.0f);
+    ENSURE_OK(kdw_view_shape_set_direction(e, s.left, &tiny_but_fine));
+    ENSURE_OK(kdw_view_shape_set_influence(e, s.left, 0.25f));
+    ENSURE_OK(kdw_view_shape_set_joints(e, s.left, g_ahoge_right.joints, g_ahoge_right.n));
+    ENSURE_OK(kdw_chain_add_view_shape(e, chain, &good, j->joints, j->n, 1.0f, &out));
+    ENSURE(out != SENTINEL_U64 && out != 0);
+    return 0;
+}
+
+static int test_error_chain_def(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 0) == 0);
+    ENSURE(step_frames(s.engine, 0, 5) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_chain_id chain = s.chains[1];
+    kdw_chain_id out = SENTINEL_U64;
+    const kdw_chain_def good = kdw_chain_def_default();
+
+    const uint32_t bad_sizes[] = {0, (uint32_t)sizeof(kdw_chain_def) - 4, (uint32_t)sizeof(kdw_chain_def) + 4, 1000};
+    for (size_t i = 0; i < sizeof bad_sizes / sizeof bad_sizes[0]; ++i) {
+        kdw_chain_def def = good;
+        def.struct_size = bad_sizes[i];
+        ENSURE_REJECTED(e, kdw_chain_create(e, &def, g_tail.joints, g_tail.n, &out), KDW_STATUS_STRUCT_SIZE_MISMATCH);
+        ENSURE_REJECTED(e, kdw_chain_set_def(e, chain, &def), KDW_STATUS_STRUCT_SIZE_MISMATCH);
+    }
+
+    kdw_chain_def bad[20];
+    int n = 0;
+    for (int i = 0; i < 20; ++i) {
+        bad[i] = good;
+    }
+    bad[n++].stiffness = 2.0f;
+    bad[n++].stiffness = NAN;
+    bad[n++].stiffness = -0.1f;
+    bad[n++].anchor = 7;
+    bad[n++].anchor = 2;
+    bad[n++].anchor = 0xFFFFFFFFu;
+    bad[n++].damping = -1.0f;
+    bad[n++].damping = 1001.0f;
+    bad[n++].damping = NAN;
+    bad[n++].momentum_suppression = 1.5f;
+    bad[n++].momentum_suppression = NAN;
+    bad[n++].mass = 0.0f;
+    bad[n++].mass = -1.0f;
+    bad[n++].mass = INFINITY;
+    bad[n++].radius = -0.01f;
+    bad[n++].radius = NAN;
+    bad[n++].gravity_scale = 101.0f;
+    bad[n++].gravity_scale = NAN;
+    for (int i = 0; i < n; ++i) {
+        ENSURE_REJECTED(e, kdw_chain_create(e, &bad[i], g_tail.joints, g_tail.n, &out), KDW_STATUS_INVALID_ARGUMENT);
+        ENSURE_REJECTED(e, kdw_chain_set_def(e, chain, &bad[i]), KDW_STATUS_INVALID_ARGUMENT);
+    }
+    ENSURE(out == SENTINEL_U64);
+    kdw_chain_def got;
+    ENSURE_OK(kdw_chain_get_def(e, chain, &got));
+    ENSURE(memcmp(&got, &good, sizeof got) == 0);
+    return 0;
+}
+
+static int test_error_engine_def(void)
+{
+    scene s; /* the target of set_def, and the witness for create */
+    ENSURE(scene_build(&s, 1) == 0);
+    ENSURE(step_frames(s.engine, 0, 5) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_engine_def good = kdw_engine_def_default();
+    kdw_engine *const marker = (kdw_engine *)(void *)&s;
+    kdw_engine *out = marker;
+
+    const uint32_t bad_sizes[] = {0, (uint32_t)sizeof(kdw_engine_def) - 4, (uint32_t)sizeof(kdw_engine_def) + 4};
+    for (size_t i = 0; i < sizeof bad_sizes / sizeof bad_sizes[0]; ++i) {
+        kdw_engine_def def = good;
+        def.struct_size = bad_sizes[i];
+        ENSURE_REJECTED(e, kdw_engine_create(&def, &out), KDW_STATUS_STRUCT_SIZE_MISMATCH);
+        ENSURE_REJECTED(e, kdw_engine_set_def(e, &def), KDW_STATUS_STRUCT_SIZE_MISMATCH);
+    }
+
+    kdw_engine_def bad[24];
+    int n = 0;
+    for (int i = 0; i < 24; ++i) {
+        bad[i] = good;
+    }
+    bad[n++].substep_rate = 0.0f;
+    bad[n++].substep_rate = NAN;
+    bad[n++].substep_rate = 29.0f;
+    bad[n++].substep_rate = 10001.0f;
+    bad[n++].substep_rate = INFINITY;
+    bad[n++].iterations = 0;
+    bad[n++].iterations = 65;
+    bad[n++].max_substeps = 0;
+    bad[n++].max_substeps = 1001;
+    bad[n++].time_scale = -1.0f;
+    bad[n++].time_scale = 101.0f;
+    bad[n++].time_scale = NAN;
+    bad[n++].teleport_distance = 0.0f;
+    bad[n++].teleport_distance = -1.0f;
+    bad[n++].teleport_distance = NAN;
+    bad[n++].teleport_distance = INFINITY;
+    bad[n++].teleport_angle = 0.0f;
+    bad[n++].teleport_angle = NAN;
+    bad[n++].gravity.y = NAN;
+    bad[n++].gravity.x = INFINITY;
+    for (int i = 0; i < n; ++i) {
+        ENSURE_REJECTED(e, kdw_engine_create(&bad[i], &out), KDW_STATUS_INVALID_ARGUMENT);
+        ENSURE_REJECTED(e, kdw_engine_set_def(e, &bad[i]), KDW_STATUS_INVALID_ARGUMENT);
+    }
+    ENSURE(out == marker);
+
+    const kdw_vec3 bad_gravity[] = {v3(NAN, 0.0f, 0.0f), v3(0.0f, -INFINITY, 0.0f)};
+    for (size_t i = 0; i < sizeof bad_gravity / sizeof bad_gravity[0]; ++i) {
+        ENSURE_REJECTED(e, kdw_engine_set_gravity(e, &bad_gravity[i]), KDW_STATUS_INVALID_ARGUMENT);
+    }
+    kdw_engine_def got;
+    ENSURE_OK(kdw_engine_get_def(e, &got));
+    ENSURE(memcmp(&got, &good, sizeof got) == 0);
+    return 0;
+}
+
+static int test_error_buffers(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    ENSURE(step_frames(s.engine, 0, 5) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_status BTS = KDW_STATUS_BUFFER_TOO_SMALL;
+    kdw_transform transforms[MAX_TOTAL];
+    kdw_quat quats[MAX_TOTAL];
+    kdw_chain_id ids[MAX_CHAINS];
+    memset(transforms, SENTINEL_BYTE, sizeof transforms);
+    memset(quats, SENTINEL_BYTE, sizeof quats);
+    memset(ids, SENTINEL_BYTE, sizeof ids);
+    uint32_t written = SENTINEL_U32;
+
+    ENSURE_REJECTED(e, kdw_engine_read_world(e, transforms, 18, &written), BTS);
+    ENSURE_REJECTED(e, kdw_engine_read_world(e, transforms, 1, &written), BTS);
+    ENSURE_REJECTED(e, kdw_engine_read_world(e, NULL, 0, &written), BTS);
+    ENSURE_REJECTED(e, kdw_engine_read_local_rotations(e, quats, 18, &written), BTS);
+    ENSURE_REJECTED(e, kdw_engine_read_local_rotations(e, NULL, 0, &written), BTS);
+    ENSURE_REJECTED(e, kdw_chain_read_world(e, s.chains[0], transforms, 7, &written), BTS);
+    ENSURE_REJECTED(e, kdw_chain_read_world(e, s.chains[0], NULL, 0, &written), BTS);
+    ENSURE_REJECTED(e, kdw_chain_read_rest_shape(e, s.chains[0], transforms, 7, &written), BTS);
+    ENSURE_REJECTED(e, kdw_engine_get_chain_ids(e, ids, 2, &written), BTS);
+    ENSURE_REJECTED(e, kdw_engine_get_chain_ids(e, NULL, 0, &written), BTS);
+    ENSURE(written == SENTINEL_U32);
+    ENSURE(bytes_are(transforms, sizeof transforms, SENTINEL_BYTE));
+    ENSURE(bytes_are(quats, sizeof quats, SENTINEL_BYTE));
+    ENSURE(bytes_are(ids, sizeof ids, SENTINEL_BYTE));
+
+    /* exactly large enough: written in full, nothing beyond touched */
+    ENSURE_OK(kdw_engine_read_world(e, transforms, 19, &written));
+    ENSURE(written == 19);
+    ENSURE(bytes_are(transforms + 19, sizeof transforms - 19 * sizeof transforms[0], SENTINEL_BYTE));
+    ENSURE_OK(kdw_engine_read_local_rotations(e, quats, 19, &written));
+    ENSURE(written == 19);
+    ENSURE(bytes_are(quats + 19, sizeof quats - 19 * sizeof quats[0], SENTINEL_BYTE));
+    ENSURE_OK(kdw_engine_get_chain_ids(e, ids, 3, &written));
+    ENSURE(written == 3);
+    ENSURE(bytes_are(ids + 3, sizeof ids - 3 * sizeof ids[0], SENTINEL_BYTE));
+    memset(transforms, SENTINEL_BYTE, sizeof transforms);
+    ENSURE_OK(kdw_chain_read_rest_shape(e, s.chains[0], transforms, 8, &written));
+    ENSURE(written == 8);
+    ENSURE(bytes_are(transforms + 8, sizeof transforms - 8 * sizeof transforms[0], SENTINEL_BYTE));
+    return 0;
+}
+
+static int test_last_error_message(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 0) == 0);
+    const kdw_transform head = head_at_rest();
+    const kdw_vec3 camera = v3(3.0f, 0.3f, 0.0f);
+    ENSURE_STATUS(kdw_engine_step(s.engine, NAN, &camera, &head), KDW_STATUS_INVALID_ARGUMENT);
+
+    uint32_t length = SENTINEL_U32;
+    ENSURE_OK(kdw_last_error_message(NULL, 0, &length)); /* length query */
+    ENSURE(length > 4 && length < 400);
+    ENSURE_OK(kdw_last_error_message(NULL, 0, NULL));
+    char full[512];
+    uint32_t full_length = SENTINEL_U32;
+    ENSURE_OK(kdw_last_error_message(full, (uint32_t)sizeof full, &full_length));
+    ENSURE(full_length == length && strlen(full) == length);
+    ENSURE(strstr(full, "dt") != NULL); /* it talks about the argument that was wrong */
+
+    /* truncation: capacity 4 -> 3 characters + NUL, full length reported, nothing beyond written */
+    char small[8];
+    memset(small, 'X', sizeof small);
+    uint32_t reported = SENTINEL_U32;
+    ENSURE_STATUS(kdw_last_error_message(small, 4, &reported), KDW_STATUS_BUFFER_TOO_SMALL);
+    ENSURE(reported == length);
+    ENSURE(small[3] == '\0' && memcmp(small, full, 3) == 0);
+    ENSURE(small[4] == 'X' && small[5] == 'X' && small[6] == 'X' && small[7] == 'X');
+
+    /* exactly the length is one too small (the NUL); length + 1 fits */
+    char exact[512];
+    memset(exact, 'X', sizeof exact);
+    ENSURE_STATUS(kdw_last_error_message(exact, length, &reported), KDW_STATUS_BUFFER_TOO_SMALL);
+    ENSURE(exact[length - 1] == '\0' && memcmp(exact, full, length - 1) == 0 && exact[length] == 'X');
+    ENSURE_OK(kdw_last_error_message(exact, length + 1, &reported));
+    ENSURE(strcmp(exact, full) == 0 && reported == length);
+    ENSURE_STATUS(kdw_last_error_message(exact, 1, NULL), KDW_STATUS_BUFFER_TOO_SMALL);
+    ENSURE(exact[0] == '\0');
+
+    /* capacity 0 with a buffer: nothing written; a NULL buffer with capacity > 0 is a NULL pointer */
+    memset(small, 'X', sizeof small);
+    ENSURE_STATUS(kdw_last_error_message(small, 0, &reported), KDW_STATUS_BUFFER_TOO_SMALL);
+    ENSURE(bytes_are(small, sizeof small, 'X'));
+    reported = SENTINEL_U32;
+    ENSURE_STATUS(kdw_last_error_message(NULL, 16, &reported), KDW_STATUS_NULL_POINTER);
+    ENSURE(reported == SENTINEL_U32);
+
+    /* neither that nor successful calls replace the message */
+    uint32_t count = 0;
+    ENSURE_OK(kdw_engine_chain_count(s.engine, &count));
+    ENSURE(step_frames(s.engine, 0, 1) == 0);
+    ENSURE_OK(kdw_last_error_message(exact, (uint32_t)sizeof exact, &reported));
+    ENSURE(strcmp(exact, full) == 0);
+
+    /* a new failure replaces it */
+    ENSURE_STATUS(kdw_chain_destroy(s.engine, 0), KDW_STATUS_INVALID_ID);
+    ENSURE_OK(kdw_last_error_message(exact, (uint32_t)sizeof exact, &reported));
+    ENSURE(reported > 0 && strcmp(exact, full) != 0);
+    return 0;
+}
+
+int main(void)
+{
+    init_shapes();
+    printf("kodawari %s (ABI %u) C tests\n", kdw_version_string(), (unsigned)kdw_abi_version());
+
+    RUN_TEST(test_last_error_initially_empty); /* first: no call may have failed before it */
+    RUN_TEST(test_layout);
+    RUN_TEST(test_version);
+    RUN_TEST(test_defaults_and_settings);
+    RUN_TEST(test_life_cycle);
+    RUN_TEST(test_view_dependence);
+    RUN_TEST(test_own_anchors);
+    RUN_TEST(test_engine_without_chains);
+    RUN_TEST(test_substep_clock);
+    RUN_TEST(test_determinism_without_view_shapes);
+    RUN_TEST(test_determinism_with_view_shapes);
+    RUN_TEST(test_teleport_camera_on_head_and_new_base);
+    RUN_TEST(test_dt_zero_changes_nothing);
+    RUN_TEST(test_non_unit_view_reference);
+    RUN_TEST(test_error_null_engine);
+    RUN_TEST(test_error_null_out_pointers);
+    RUN_TEST(test_error_null_inputs);
+    RUN_TEST(test_error_ids);
+    RUN_TEST(test_error_step_inputs);
+    RUN_TEST(test_error_chain_shapes);
+    RUN_TEST(test_error_view_shapes);
+    RUN_TEST(test_error_chain_def);
+    RUN_TEST(test_error_engine_def);
+    RUN_TEST(test_error_buffers);
+    RUN_TEST(test_last_error_message);
+
+    return HARNESS_SUMMARY();
+}

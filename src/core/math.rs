@@ -119,7 +119,7 @@ pub fn rotation_angle(q: Quat) -> f32 {
 /// is scaled to 1 first, so squaring neither underflows nor overflows); `None` for zero or non-finite.
 pub fn normalized_rotation(q: Quat) -> Option<Quat> {
     let largest = q.x.abs().max(q.y.abs()).max(q.z.abs()).max(q.w.abs());
-    if !(largest > 0.0 && largest.is_finite()) || !q.is_finite() {
+    if !(largest > 0.0 && largest.is_finite() && q.is_finite()) {
         return None;
     }
     Some((q / largest).normalize())
@@ -128,7 +128,7 @@ pub fn normalized_rotation(q: Quat) -> Option<Quat> {
 /// Unit direction of any finite non-zero `v` (scaled like [`normalized_rotation`]); `None` otherwise.
 pub fn normalized_direction(v: Vec3) -> Option<Vec3> {
     let largest = v.abs().max_element();
-    if !(largest > 0.0 && largest.is_finite()) || !v.is_finite() {
+    if !(largest > 0.0 && largest.is_finite() && v.is_finite()) {
         return None;
     }
     Some((v / largest).normalize())

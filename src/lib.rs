@@ -5,12 +5,15 @@
 //! the rest shape of an elastic rod that is simulated as usual.
 //!
 //! - [`core`]: the engine in plain safe Rust.
-//! - `ffi` (not public in Rust): the C ABI in `include/kodawari.h`, the only place with `extern "C"`.
+//! - `ffi` (hidden): the C ABI in `include/kodawari.h`, the only place with `extern "C"`.
 #![deny(unsafe_op_in_unsafe_fn)]
 // Numerical kernels index several parallel arrays with one joint index; iterator zips would hide that.
 #![allow(clippy::needless_range_loop)]
 
 pub mod core;
-mod ffi;
+/// The C ABI. Public only so Rust tests and fuzzers can drive the exact functions C hosts call; not a Rust
+/// API (use [`core`]).
+#[doc(hidden)]
+pub mod ffi;
 
 pub use crate::core::*;

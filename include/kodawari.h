@@ -144,6 +144,10 @@ typedef uint64_t kdw_view_shape_id;
 // `struct_size` of a def struct does not match this library.
 #define KDW_STATUS_STRUCT_SIZE_MISMATCH -6
 
+// The library's `kdw_abi_version()` differs from the `KDW_ABI_VERSION` a caller (or a binding) was
+// built against. Never returned by the library itself; the C++ and C# bindings report it.
+#define KDW_STATUS_ABI_MISMATCH -7
+
 // A bug inside the library was caught at the boundary. The engine involved refuses further calls
 // except `kdw_engine_destroy`.
 #define KDW_STATUS_PANIC -100
@@ -216,7 +220,8 @@ struct kdw_engine_def kdw_engine_def_default(void);
 // Creates an engine. `*out_engine` receives it; destroy it with `kdw_engine_destroy`.
 kdw_status kdw_engine_create(const struct kdw_engine_def *def, struct kdw_engine **out_engine);
 
-// Destroys an engine and everything it owns. Every id of it becomes invalid.
+// Destroys an engine and everything it owns. Every id of it becomes invalid. NULL is a no-op (like
+// `free(NULL)`), so cleanup paths need no check.
 kdw_status kdw_engine_destroy(struct kdw_engine *engine);
 
 // Reads the engine's current settings.
@@ -335,6 +340,11 @@ kdw_status kdw_view_shape_remove(struct kdw_engine *engine, kdw_view_shape_id vi
 kdw_status kdw_chain_view_shape_count(const struct kdw_engine *engine,
                                       kdw_chain_id chain,
                                       uint32_t *out_count);
+
+// `*out_valid` = 1 if `view_shape` names a live view shape of this engine, else 0.
+kdw_status kdw_view_shape_is_valid(const struct kdw_engine *engine,
+                                   kdw_view_shape_id view_shape,
+                                   uint32_t *out_valid);
 
 #ifdef __cplusplus
 }  // extern "C"

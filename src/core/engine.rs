@@ -240,6 +240,10 @@ impl Engine {
         Ok((chain, index))
     }
 
+    pub fn is_view_shape_valid(&self, id: ViewShapeId) -> bool {
+        self.view_shapes.get(Id::from_bits(id.to_bits())).is_some()
+    }
+
     pub fn set_view_shape_influence(&mut self, id: ViewShapeId, influence: f32) -> Result<()> {
         validate_influence(influence)?;
         let (chain, index) = self.view_shape_mut(id)?;
@@ -457,36 +461,53 @@ impl Engine {
         Ok(i)
     }
 
-    /// World transforms of one chain's joints.
-    pub fn read_chain_world(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
+    /// Calls `f` with the world transform of each joint of one chain; fails without calling it when
+    /// `capacity` is below the chain's joint count.
+    pub fn for_each_chain_world_transform(
+        &self,
+        id: ChainId,
+        capacity: usize,
+        mut f: impl FnMut(Transform),
+    ) -> Result<()> {
         let chain = self.chain(id)?;
-        if out.len() < chain.joint_count() {
-            return Err(Error::buffer_too_small(format!(
-                "buffer holds {} transforms, the chain has {}",
-                out.len(),
-                chain.joint_count()
-            )));
-        }
-        for (slot, local) in out.iter_mut().zip(&chain.output) {
-            *slot = chain.anchor.mul(local);
-        }
-        Ok(chain.joint_count())
+        check_chain_capacity(chain, capacity)?;
+        chain.output.iter().for_each(|local| f(chain.anchor.mul(local)));
+        Ok(())
     }
 
-    /// The rest shape a chain is currently pulled towards (anchor frame).
-    pub fn chain_rest_shape(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
+    /// Calls `f` with each joint of the rest shape a chain is currently pulled towards (anchor frame).
+    pub fn for_each_chain_rest_transform(
+        &self,
+        id: ChainId,
+        capacity: usize,
+        mut f: impl FnMut(Transform),
+    ) -> Result<()> {
         let chain = self.chain(id)?;
-        if out.len() < chain.joint_count() {
-            return Err(Error::buffer_too_small(format!(
-                "buffer holds {} transforms, the chain has {}",
-                out.len(),
-                chain.joint_count()
-            )));
+        check_chain_capacity(chain, capacity)?;
+        for (p, q) in chain.rest.positions.iter().zip(&chain.rest.orientations) {
+            f(Transform::new(*p, *q));
         }
-        for (j, slot) in out.iter_mut().enumerate().take(chain.joint_count()) {
-            *slot = Transform::new(chain.rest.positions[j], chain.rest.orientations[j]);
-        }
-        Ok(chain.joint_count())
+        Ok(())
+    }
+
+    /// World transforms of one chain's joints into `out`; returns how many were written.
+    pub fn read_chain_world(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
+        let mut i = 0;
+        self.for_each_chain_world_transform(id, out.len(), |t| {
+            out[i] = t;
+            i += 1;
+        })?;
+        Ok(i)
+    }
+
+    /// The rest shape a chain is currently pulled towards (anchor frame) into `out`.
+    pub fn chain_rest_shape(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
+        let mut i = 0;
+        self.for_each_chain_rest_transform(id, out.len(), |t| {
+            out[i] = t;
+            i += 1;
+        })?;
+        Ok(i)
     }
 
     /// Kinetic energy of a chain's dynamic particles (J), from internal velocities.
@@ -568,6 +589,16 @@ impl Engine {
         words.hash(&mut hasher);
         hasher.finish()
     }
+}
+
+fn check_chain_capacity(chain: &Chain, capacity: usize) -> Result<()> {
+    if capacity < chain.joint_count() {
+        return Err(Error::buffer_too_small(format!(
+            "buffer holds {capacity} transforms, the chain has {}",
+            chain.joint_count()
+        )));
+    }
+    Ok(())
 }
 
 fn is_teleport(from: &Transform, to: &Transform, settings: &EngineSettings) -> bool {

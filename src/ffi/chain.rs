@@ -1,7 +1,7 @@
 //! `kdw_chain_*`: a joint chain (`ViewDependentPhysicalObject`), its base shape and parameters.
 
 use super::engine::kdw_engine;
-use super::guard::{check_out, check_struct_size, guard, read, slice, slice_mut, with_engine, with_engine_mut, write};
+use super::guard::{check_out, check_struct_size, fill, guard, query, read, slice, store_each, with_engine_mut, write};
 use super::status::{FfiResult, kdw_status};
 use super::types::{kdw_chain_def, kdw_chain_id, kdw_transform};
 use crate::core::{ChainId, ChainParams, Transform};
@@ -61,14 +61,7 @@ pub extern "C" fn kdw_chain_is_valid(
     chain: kdw_chain_id,
     out_valid: *mut u32,
 ) -> kdw_status {
-    guard(|| {
-        check_out(out_valid, "out_valid")?;
-        // SAFETY: live engine handle.
-        let valid = unsafe { with_engine(engine, |e| Ok(e.is_chain_valid(ChainId::from_bits(chain)) as u32)) }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_valid, valid) };
-        Ok(())
-    })
+    query(engine, out_valid, "out_valid", |e| Ok(e.is_chain_valid(ChainId::from_bits(chain)) as u32))
 }
 
 /// Reads a chain's parameters.
@@ -78,14 +71,7 @@ pub extern "C" fn kdw_chain_get_def(
     chain: kdw_chain_id,
     out_def: *mut kdw_chain_def,
 ) -> kdw_status {
-    guard(|| {
-        check_out(out_def, "out_def")?;
-        // SAFETY: live engine handle.
-        let params = unsafe { with_engine(engine, |e| Ok(e.chain_params(ChainId::from_bits(chain))?)) }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_def, params.into()) };
-        Ok(())
-    })
+    query(engine, out_def, "out_def", |e| Ok(e.chain_params(ChainId::from_bits(chain))?.into()))
 }
 
 /// Replaces a chain's parameters (validated as a whole; nothing changes on error). Takes effect at the
@@ -135,14 +121,7 @@ pub extern "C" fn kdw_chain_joint_count(
     chain: kdw_chain_id,
     out_count: *mut u32,
 ) -> kdw_status {
-    guard(|| {
-        check_out(out_count, "out_count")?;
-        // SAFETY: live engine handle.
-        let n = unsafe { with_engine(engine, |e| Ok(e.chain_joint_count(ChainId::from_bits(chain))? as u32)) }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_count, n) };
-        Ok(())
-    })
+    query(engine, out_count, "out_count", |e| Ok(e.chain_joint_count(ChainId::from_bits(chain))? as u32))
 }
 
 /// One chain's world transforms (as `kdw_engine_read_world`, for that chain only).
@@ -154,8 +133,8 @@ pub extern "C" fn kdw_chain_read_world(
     capacity: u32,
     out_written: *mut u32,
 ) -> kdw_status {
-    read_chain_transforms(engine, chain, out_transforms, capacity, out_written, |e, id, out| {
-        e.read_chain_world(id, out)
+    fill(engine, out_transforms, capacity, out_written, "out_transforms", |e, out| {
+        store_each(out, |capacity, f| e.for_each_chain_world_transform(ChainId::from_bits(chain), capacity, f))
     })
 }
 
@@ -169,8 +148,8 @@ pub extern "C" fn kdw_chain_read_rest_shape(
     capacity: u32,
     out_written: *mut u32,
 ) -> kdw_status {
-    read_chain_transforms(engine, chain, out_transforms, capacity, out_written, |e, id, out| {
-        e.chain_rest_shape(id, out)
+    fill(engine, out_transforms, capacity, out_written, "out_transforms", |e, out| {
+        store_each(out, |capacity, f| e.for_each_chain_rest_transform(ChainId::from_bits(chain), capacity, f))
     })
 }
 
@@ -181,42 +160,5 @@ pub extern "C" fn kdw_chain_kinetic_energy(
     chain: kdw_chain_id,
     out_energy: *mut f32,
 ) -> kdw_status {
-    guard(|| {
-        check_out(out_energy, "out_energy")?;
-        // SAFETY: live engine handle.
-        let energy = unsafe { with_engine(engine, |e| Ok(e.chain_kinetic_energy(ChainId::from_bits(chain))?)) }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_energy, energy) };
-        Ok(())
-    })
-}
-
-fn read_chain_transforms(
-    engine: *const kdw_engine,
-    chain: kdw_chain_id,
-    out_transforms: *mut kdw_transform,
-    capacity: u32,
-    out_written: *mut u32,
-    read_into: impl FnOnce(&crate::core::Engine, ChainId, &mut [Transform]) -> crate::core::Result<usize>,
-) -> kdw_status {
-    guard(|| {
-        check_out(out_written, "out_written")?;
-        // SAFETY: the caller passes `capacity` writable transforms.
-        let out = unsafe { slice_mut(out_transforms, capacity, "out_transforms") }?;
-        // SAFETY: live engine handle.
-        let written = unsafe {
-            with_engine(engine, |e| {
-                let id = ChainId::from_bits(chain);
-                let mut buffer = vec![Transform::IDENTITY; e.chain_joint_count(id)?.min(out.len())];
-                let n = read_into(e, id, &mut buffer)?;
-                for (slot, t) in out.iter_mut().zip(&buffer) {
-                    *slot = (*t).into();
-                }
-                Ok(n as u32)
-            })
-        }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_written, written) };
-        Ok(())
-    })
+    query(engine, out_energy, "out_energy", |e| Ok(e.chain_kinetic_energy(ChainId::from_bits(chain))?))
 }

@@ -1,12 +1,10 @@
 //! `kdw_engine`: create, configure, step, read back.
 
-use glam::Quat;
-
 use super::guard::{
-    check_out, check_struct_size, destroy_handle, guard, into_handle, read, slice, slice_mut, with_engine,
+    check_out, check_struct_size, destroy_handle, fill, guard, into_handle, query, read, slice, store_each,
     with_engine_mut, write,
 };
-use super::status::kdw_status;
+use super::status::{KDW_STATUS_OK, kdw_status};
 use super::types::{kdw_chain_id, kdw_engine_def, kdw_engine_stats, kdw_quat, kdw_transform, kdw_vec3};
 use crate::core::{Engine, EngineSettings, Transform};
 
@@ -36,9 +34,13 @@ pub extern "C" fn kdw_engine_create(def: *const kdw_engine_def, out_engine: *mut
     })
 }
 
-/// Destroys an engine and everything it owns. Every id of it becomes invalid.
+/// Destroys an engine and everything it owns. Every id of it becomes invalid. NULL is a no-op (like
+/// `free(NULL)`), so cleanup paths need no check.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engine_destroy(engine: *mut kdw_engine) -> kdw_status {
+    if engine.is_null() {
+        return KDW_STATUS_OK;
+    }
     // SAFETY: the caller passes a pointer from kdw_engine_create that it no longer uses afterwards.
     guard(|| unsafe { destroy_handle(engine) })
 }
@@ -46,14 +48,7 @@ pub extern "C" fn kdw_engine_destroy(engine: *mut kdw_engine) -> kdw_status {
 /// Reads the engine's current settings.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engine_get_def(engine: *const kdw_engine, out_def: *mut kdw_engine_def) -> kdw_status {
-    guard(|| {
-        check_out(out_def, "out_def")?;
-        // SAFETY: `engine` is a live engine handle (caller contract).
-        let def: kdw_engine_def = unsafe { with_engine(engine, |e| Ok((*e.settings()).into())) }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_def, def) };
-        Ok(())
-    })
+    query(engine, out_def, "out_def", |e| Ok((*e.settings()).into()))
 }
 
 /// Replaces all settings at once (validated as a whole; nothing changes on error).
@@ -120,27 +115,13 @@ pub extern "C" fn kdw_engine_set_anchors(
 /// Number of chains.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engine_chain_count(engine: *const kdw_engine, out_count: *mut u32) -> kdw_status {
-    guard(|| {
-        check_out(out_count, "out_count")?;
-        // SAFETY: live engine handle.
-        let count = unsafe { with_engine(engine, |e| Ok(e.chain_count() as u32)) }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_count, count) };
-        Ok(())
-    })
+    query(engine, out_count, "out_count", |e| Ok(e.chain_count() as u32))
 }
 
 /// Total number of joints of all chains: the size `kdw_engine_read_world` needs.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engine_joint_count(engine: *const kdw_engine, out_count: *mut u32) -> kdw_status {
-    guard(|| {
-        check_out(out_count, "out_count")?;
-        // SAFETY: live engine handle.
-        let count = unsafe { with_engine(engine, |e| Ok(e.joint_count() as u32)) }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_count, count) };
-        Ok(())
-    })
+    query(engine, out_count, "out_count", |e| Ok(e.joint_count() as u32))
 }
 
 /// Chain ids in creation order (the order of every batched call). `capacity` must be at least the chain
@@ -152,30 +133,15 @@ pub extern "C" fn kdw_engine_get_chain_ids(
     capacity: u32,
     out_written: *mut u32,
 ) -> kdw_status {
-    guard(|| {
-        check_out(out_written, "out_written")?;
-        // SAFETY: the caller passes `capacity` writable ids.
-        let out = unsafe { slice_mut(out_ids, capacity, "out_ids") }?;
-        // SAFETY: live engine handle.
-        let written = unsafe {
-            with_engine(engine, |e| {
-                if out.len() < e.chain_count() {
-                    return Err(crate::core::Error::buffer_too_small(format!(
-                        "buffer holds {} ids, the engine has {} chains",
-                        out.len(),
-                        e.chain_count()
-                    ))
-                    .into());
-                }
-                for (slot, id) in out.iter_mut().zip(e.chain_ids()) {
-                    *slot = id.to_bits();
-                }
-                Ok(e.chain_count() as u32)
-            })
-        }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_written, written) };
-        Ok(())
+    fill(engine, out_ids, capacity, out_written, "out_ids", |e, out| {
+        if out.len() < e.chain_count() {
+            let message = format!("buffer holds {} ids, the engine has {} chains", out.len(), e.chain_count());
+            return Err(crate::core::Error::buffer_too_small(message).into());
+        }
+        for (slot, id) in out.iter_mut().zip(e.chain_ids()) {
+            *slot = id.to_bits();
+        }
+        Ok(e.chain_count())
     })
 }
 
@@ -189,24 +155,8 @@ pub extern "C" fn kdw_engine_read_world(
     capacity: u32,
     out_written: *mut u32,
 ) -> kdw_status {
-    guard(|| {
-        check_out(out_written, "out_written")?;
-        // SAFETY: the caller passes `capacity` writable transforms.
-        let out = unsafe { slice_mut(out_transforms, capacity, "out_transforms") }?;
-        // SAFETY: live engine handle.
-        let written = unsafe {
-            with_engine(engine, |e| {
-                let mut i = 0usize;
-                e.for_each_world_transform(out.len(), |t| {
-                    out[i] = t.into();
-                    i += 1;
-                })?;
-                Ok(i as u32)
-            })
-        }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_written, written) };
-        Ok(())
+    fill(engine, out_transforms, capacity, out_written, "out_transforms", |e, out| {
+        store_each(out, |capacity, f| e.for_each_world_transform(capacity, f))
     })
 }
 
@@ -219,38 +169,15 @@ pub extern "C" fn kdw_engine_read_local_rotations(
     capacity: u32,
     out_written: *mut u32,
 ) -> kdw_status {
-    guard(|| {
-        check_out(out_written, "out_written")?;
-        // SAFETY: the caller passes `capacity` writable quaternions.
-        let out = unsafe { slice_mut(out_rotations, capacity, "out_rotations") }?;
-        // SAFETY: live engine handle.
-        let written = unsafe {
-            with_engine(engine, |e| {
-                let mut i = 0usize;
-                e.for_each_local_rotation(out.len(), |q: Quat| {
-                    out[i] = q.into();
-                    i += 1;
-                })?;
-                Ok(i as u32)
-            })
-        }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_written, written) };
-        Ok(())
+    fill(engine, out_rotations, capacity, out_written, "out_rotations", |e, out| {
+        store_each(out, |capacity, f| e.for_each_local_rotation(capacity, f))
     })
 }
 
 /// Counters: chains, joints, substeps run, time dropped, chains asleep.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engine_get_stats(engine: *const kdw_engine, out_stats: *mut kdw_engine_stats) -> kdw_status {
-    guard(|| {
-        check_out(out_stats, "out_stats")?;
-        // SAFETY: live engine handle.
-        let stats = unsafe { with_engine(engine, |e| Ok(e.stats())) }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_stats, stats.into()) };
-        Ok(())
-    })
+    query(engine, out_stats, "out_stats", |e| Ok(e.stats().into()))
 }
 
 /// Puts every chain back to its rest shape, at rest, at the next step.
@@ -269,12 +196,5 @@ pub extern "C" fn kdw_engine_reset(engine: *mut kdw_engine) -> kdw_status {
 /// an unchanged hash after a rejected call shows the engine was left untouched.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engine_state_hash(engine: *const kdw_engine, out_hash: *mut u64) -> kdw_status {
-    guard(|| {
-        check_out(out_hash, "out_hash")?;
-        // SAFETY: live engine handle.
-        let hash = unsafe { with_engine(engine, |e| Ok(e.state_hash())) }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_hash, hash) };
-        Ok(())
-    })
+    query(engine, out_hash, "out_hash", |e| Ok(e.state_hash()))
 }

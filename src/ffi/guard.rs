@@ -165,3 +165,58 @@ pub(crate) fn check_struct_size<T>(struct_size: u32, name: &str) -> FfiResult<()
     }
     Ok(())
 }
+
+/// The shape of every read-only query: check the out-pointer, run `f` on the engine, write its result
+/// only on success.
+pub(crate) fn query<T>(
+    engine: *const kdw_engine,
+    out: *mut T,
+    what: &str,
+    f: impl FnOnce(&Engine) -> FfiResult<T>,
+) -> kdw_status {
+    guard(|| {
+        check_out(out, what)?;
+        // SAFETY: `engine` is a live engine handle (caller contract, NULL checked inside).
+        let value = unsafe { with_engine(engine, f) }?;
+        // SAFETY: checked by check_out; writability is the caller's contract.
+        unsafe { write(out, value) };
+        Ok(())
+    })
+}
+
+/// The shape of every batched read: `f` fills the caller's buffer of `capacity` elements and returns how
+/// many it wrote, which goes to `*out_written` only on success.
+pub(crate) fn fill<T>(
+    engine: *const kdw_engine,
+    buffer: *mut T,
+    capacity: u32,
+    out_written: *mut u32,
+    what: &str,
+    f: impl FnOnce(&Engine, &mut [T]) -> FfiResult<usize>,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_written, "out_written")?;
+        // SAFETY: the caller passes `capacity` writable elements at `buffer`.
+        let out = unsafe { slice_mut(buffer, capacity, what) }?;
+        // SAFETY: `engine` is a live engine handle (caller contract, NULL checked inside).
+        let written = unsafe { with_engine(engine, |e| f(e, out)) }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_written, written as u32) };
+        Ok(())
+    })
+}
+
+/// Adapts a core visitor (`for_each_*`) to a C output buffer: converts and stores each item in order and
+/// returns how many were stored. The visitor checks the capacity before it calls back.
+pub(crate) fn store_each<T, C: From<T>>(
+    out: &mut [C],
+    visit: impl FnOnce(usize, &mut dyn FnMut(T)) -> crate::core::Result<()>,
+) -> FfiResult<usize> {
+    let capacity = out.len();
+    let mut stored = 0;
+    visit(capacity, &mut |item| {
+        out[stored] = item.into();
+        stored += 1;
+    })?;
+    Ok(stored)
+}

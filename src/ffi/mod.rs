@@ -5,7 +5,8 @@
 //! - [`guard`]: the panic guard and the pointer checks every exported body goes through
 //! - one module per C concept: [`engine`], [`chain`], [`view_shape`], [`version`]
 
-#![allow(non_camel_case_types)] // C names, exactly as in the header.
+#![allow(non_camel_case_types)]
+// C names, exactly as in the header.
 // Entry points are safe `extern "C"` functions, as in rustls-ffi: they check what can be checked (NULL,
 // alignment, ids, values) and the validity of non-NULL pointers is the C caller's contract, stated in the
 // header. Rust code reaches them only from tests.

@@ -22,6 +22,9 @@ pub const KDW_STATUS_BUFFER_TOO_SMALL: kdw_status = -4;
 pub const KDW_STATUS_CAPACITY_EXCEEDED: kdw_status = -5;
 /// `struct_size` of a def struct does not match this library.
 pub const KDW_STATUS_STRUCT_SIZE_MISMATCH: kdw_status = -6;
+/// The library's `kdw_abi_version()` differs from the `KDW_ABI_VERSION` a caller (or a binding) was
+/// built against. Never returned by the library itself; the C++ and C# bindings report it.
+pub const KDW_STATUS_ABI_MISMATCH: kdw_status = -7;
 /// A bug inside the library was caught at the boundary. The engine involved refuses further calls
 /// except `kdw_engine_destroy`.
 pub const KDW_STATUS_PANIC: kdw_status = -100;
@@ -75,6 +78,7 @@ pub extern "C" fn kdw_status_str(status: kdw_status) -> *const c_char {
         KDW_STATUS_BUFFER_TOO_SMALL => b"buffer too small\0",
         KDW_STATUS_CAPACITY_EXCEEDED => b"capacity exceeded\0",
         KDW_STATUS_STRUCT_SIZE_MISMATCH => b"struct_size does not match this library\0",
+        KDW_STATUS_ABI_MISMATCH => b"the library's ABI version differs from the header's\0",
         KDW_STATUS_PANIC => b"internal error (panic caught at the boundary)\0",
         _ => b"unknown status\0",
     };

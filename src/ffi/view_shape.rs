@@ -2,7 +2,7 @@
 
 use super::chain::joints_from;
 use super::engine::kdw_engine;
-use super::guard::{check_out, guard, read, slice, with_engine_mut, write};
+use super::guard::{check_out, guard, query, read, slice, with_engine_mut, write};
 use super::status::kdw_status;
 use super::types::{kdw_chain_id, kdw_transform, kdw_vec3, kdw_view_shape_id};
 use crate::core::{ChainId, ViewShapeId};
@@ -104,14 +104,15 @@ pub extern "C" fn kdw_chain_view_shape_count(
     chain: kdw_chain_id,
     out_count: *mut u32,
 ) -> kdw_status {
-    guard(|| {
-        check_out(out_count, "out_count")?;
-        // SAFETY: live engine handle.
-        let n = unsafe {
-            super::guard::with_engine(engine, |e| Ok(e.view_shape_count(ChainId::from_bits(chain))? as u32))
-        }?;
-        // SAFETY: checked by check_out.
-        unsafe { write(out_count, n) };
-        Ok(())
-    })
+    query(engine, out_count, "out_count", |e| Ok(e.view_shape_count(ChainId::from_bits(chain))? as u32))
+}
+
+/// `*out_valid` = 1 if `view_shape` names a live view shape of this engine, else 0.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_view_shape_is_valid(
+    engine: *const kdw_engine,
+    view_shape: kdw_view_shape_id,
+    out_valid: *mut u32,
+) -> kdw_status {
+    query(engine, out_valid, "out_valid", |e| Ok(e.is_view_shape_valid(ViewShapeId::from_bits(view_shape)) as u32))
 }

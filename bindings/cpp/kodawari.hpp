@@ -1,0 +1,597 @@
+// kodawari C++ binding: header-only C++17 RAII over the C API in kodawari.h.
+//
+//   kodawari::Engine                      owns a kdw_engine* (move-only, destroyed by its destructor)
+//   kodawari::ViewDependentPhysicalObject a chain: non-owning handle (engine pointer + kdw_chain_id)
+//   kodawari::ViewShape                   a view shape of a chain: non-owning handle
+//   kodawari::EngineDef / ChainDef        the C def structs, initialised to the library defaults
+//
+// Errors: by default every failing call throws kodawari::Error (status + the library's message). Define
+// KODAWARI_NO_EXCEPTIONS before including this header to get no throws at all: the same methods then
+// return kodawari::Result<T> (or kodawari::Status for calls without a value), expected-style and
+// [[nodiscard]]. `kodawari::Ret<T>` names what a method returns in the current mode (T or Result<T>).
+// With exceptions, getters are [[nodiscard]]; a created chain or view shape handle may be ignored (the
+// engine owns the object).
+// Both modes can be mixed in one program: each lives in its own inline namespace.
+//
+// Handles hold the raw kdw_engine*, so they stay usable when the owning Engine object is moved, and must
+// not be used after the engine is destroyed. Ids are validated by the library on every call: a stale id
+// fails with KDW_STATUS_INVALID_ID, never undefined behaviour.
+
+#ifndef KODAWARI_HPP
+#define KODAWARI_HPP
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "kodawari.h"
+
+// Built with exceptions disabled (-fno-exceptions, /EHs-c-): no-exception mode whether asked for or not.
+#if !defined(KODAWARI_NO_EXCEPTIONS) && !defined(__cpp_exceptions) && !defined(__EXCEPTIONS) && !defined(_CPPUNWIND)
+#define KODAWARI_NO_EXCEPTIONS
+#endif
+
+#ifdef KODAWARI_NO_EXCEPTIONS
+#define KODAWARI_DETAIL_MODE no_exceptions
+#else
+#define KODAWARI_DETAIL_MODE exceptions
+#endif
+
+namespace kodawari {
+inline namespace KODAWARI_DETAIL_MODE {
+
+using Vec3 = kdw_vec3;
+using Quat = kdw_quat;
+using Transform = kdw_transform;
+using ChainId = kdw_chain_id;
+using ViewShapeId = kdw_view_shape_id;
+using EngineStats = kdw_engine_stats;
+
+/// The loaded library's ABI version differs from the header's.
+inline constexpr kdw_status kStatusAbiMismatch = KDW_STATUS_ABI_MISMATCH;
+
+/// The library's ABI version (compare with KDW_ABI_VERSION).
+inline uint32_t abiVersion() noexcept { return kdw_abi_version(); }
+
+/// The library's version string, e.g. "0.1.0".
+inline const char* versionString() noexcept { return kdw_version_string(); }
+
+/// A static description of a status.
+inline const char* statusString(kdw_status status) noexcept {
+    return kdw_status_str(status);
+}
+
+/// This thread's message about its last failed C call (empty if none).
+inline std::string lastErrorMessage() {
+    uint32_t length = 0;
+    if (kdw_last_error_message(nullptr, 0, &length) != KDW_STATUS_OK || length == 0) return {};
+    std::string message(length + 1, '\0');
+    if (kdw_last_error_message(&message[0], length + 1, &length) != KDW_STATUS_OK) return {};
+    message.resize(length);
+    return message;
+}
+
+/// A failed call: the status and the library's detail message. `what()` is "<status>: <message>".
+class Error : public std::runtime_error {
+public:
+    /// Wraps a failing status and its detail message.
+    Error(kdw_status status, const std::string& message)
+        : std::runtime_error(std::string(statusString(status)) + (message.empty() ? "" : ": " + message)),
+          status_(status), message_(message) {}
+    /// The KDW_STATUS_* value.
+    kdw_status status() const noexcept { return status_; }
+    /// The library's detail message (kdw_last_error_message at the time of the failure).
+    const std::string& message() const noexcept { return message_; }
+
+private:
+    kdw_status status_;
+    std::string message_;
+};
+
+/// Outcome of a call without a value: OK, or a failing status with its message.
+class [[nodiscard]] Status {
+public:
+    /// Success.
+    Status() noexcept = default;
+    /// A status with its detail message.
+    Status(kdw_status status, std::string message) noexcept : status_(status), message_(std::move(message)) {}
+    /// True on success.
+    bool ok() const noexcept { return status_ == KDW_STATUS_OK; }
+    /// True on success.
+    explicit operator bool() const noexcept { return ok(); }
+    /// The KDW_STATUS_* value (KDW_STATUS_OK on success).
+    kdw_status status() const noexcept { return status_; }
+    /// The library's detail message (empty on success).
+    const std::string& message() const noexcept { return message_; }
+
+private:
+    kdw_status status_ = KDW_STATUS_OK;
+    std::string message_;
+};
+
+/// Outcome of a call with a value: the value, or a failing status with its message (like std::expected).
+template <class T>
+class [[nodiscard]] Result {
+public:
+    /// Success with a value.
+    Result(T value) : value_(std::move(value)) {}
+    /// Failure (`error` must not be OK).
+    Result(Status error) : status_(std::move(error)) {}
+    /// True on success.
+    bool ok() const noexcept { return status_.ok(); }
+    /// True on success.
+    explicit operator bool() const noexcept { return ok(); }
+    /// The value; calling it on a failure throws Error (aborts under KODAWARI_NO_EXCEPTIONS).
+    T& value() & {
+        ensure();
+        return value_;
+    }
+    /// The value; calling it on a failure throws Error (aborts under KODAWARI_NO_EXCEPTIONS).
+    const T& value() const& {
+        ensure();
+        return value_;
+    }
+    /// The value, moved out; calling it on a failure throws Error (aborts under KODAWARI_NO_EXCEPTIONS).
+    T&& value() && {
+        ensure();
+        return std::move(value_);
+    }
+    /// The value on success, else `fallback`.
+    T valueOr(T fallback) const& { return ok() ? value_ : fallback; }
+    /// The KDW_STATUS_* value (KDW_STATUS_OK on success).
+    kdw_status status() const noexcept { return status_.status(); }
+    /// The library's detail message (empty on success).
+    const std::string& message() const noexcept { return status_.message(); }
+
+private:
+    void ensure() const {
+        if (ok()) return;
+#ifdef KODAWARI_NO_EXCEPTIONS
+        std::abort();
+#else
+        throw Error(status_.status(), status_.message());
+#endif
+    }
+    T value_{};
+    Status status_;
+};
+
+namespace detail {
+#ifdef KODAWARI_NO_EXCEPTIONS
+template <class T>
+struct ReturnType { using type = Result<T>; };
+template <>
+struct ReturnType<void> { using type = Status; };
+#else
+template <class T>
+struct ReturnType { using type = T; };
+#endif
+}  // namespace detail
+
+/// What a fallible method returns: `T` (exceptions) or `Result<T>` / `Status` (KODAWARI_NO_EXCEPTIONS).
+template <class T>
+using Ret = typename detail::ReturnType<T>::type;
+
+namespace detail {
+/// The one place a status becomes an error: throws Error, or returns a Status under KODAWARI_NO_EXCEPTIONS.
+inline Ret<void> check(kdw_status status, const char* message = nullptr) {
+    if (status == KDW_STATUS_OK) return Ret<void>();
+#ifdef KODAWARI_NO_EXCEPTIONS
+    return Status(status, message ? std::string(message) : lastErrorMessage());
+#else
+    throw Error(status, message ? std::string(message) : lastErrorMessage());
+#endif
+}
+
+/// `value` if `status` is OK, else the error of check().
+template <class T>
+Ret<T> result(kdw_status status, T value) {
+#ifdef KODAWARI_NO_EXCEPTIONS
+    if (status != KDW_STATUS_OK) return check(status);
+#else
+    check(status);
+#endif
+    return value;
+}
+}  // namespace detail
+
+// Returns early from the enclosing method with the failure of `expr` (a check() result).
+#ifdef KODAWARI_NO_EXCEPTIONS
+#define KODAWARI_DETAIL_TRY(expr)                        \
+    do {                                                 \
+        ::kodawari::Status kdw_try_status = (expr);      \
+        if (!kdw_try_status.ok()) return kdw_try_status; \
+    } while (0)
+#else
+#define KODAWARI_DETAIL_TRY(expr) expr
+#endif
+
+/// A contiguous, non-owning view of `T` (a C++17 stand-in for std::span): from a pointer + count, a C
+/// array, or any container with data() and size() (std::vector, std::array).
+template <class T>
+class Span {
+public:
+    /// Empty.
+    constexpr Span() noexcept = default;
+    /// `size` elements starting at `data`.
+    constexpr Span(T* data, uint32_t size) noexcept : data_(data), size_(size) {}
+    /// A whole C array.
+    template <std::size_t N>
+    constexpr Span(T (&array)[N]) noexcept : data_(array), size_(static_cast<uint32_t>(N)) {}
+    /// A whole container (std::vector, std::array, ...).
+    template <class Container,
+              class = std::enable_if_t<!std::is_same_v<std::decay_t<Container>, Span> &&
+                                       std::is_convertible_v<decltype(std::declval<Container&>().data()), T*>>>
+    constexpr Span(Container&& container) noexcept
+        : data_(container.data()), size_(static_cast<uint32_t>(container.size())) {}
+    /// First element.
+    constexpr T* data() const noexcept { return data_; }
+    /// Number of elements.
+    constexpr uint32_t size() const noexcept { return size_; }
+    /// True if there are no elements.
+    constexpr bool empty() const noexcept { return size_ == 0; }
+    /// Start of the range.
+    constexpr T* begin() const noexcept { return data_; }
+    /// End of the range.
+    constexpr T* end() const noexcept { return data_ + size_; }
+    /// Element `i` (unchecked).
+    constexpr T& operator[](uint32_t i) const noexcept { return data_[i]; }
+
+private:
+    T* data_ = nullptr;
+    uint32_t size_ = 0;
+};
+
+/// Engine settings, initialised to kdw_engine_def_default().
+struct EngineDef : kdw_engine_def {
+    /// The library defaults.
+    EngineDef() noexcept : kdw_engine_def(kdw_engine_def_default()) {}
+};
+
+/// Chain parameters, initialised to kdw_chain_def_default().
+struct ChainDef : kdw_chain_def {
+    /// The library defaults.
+    ChainDef() noexcept : kdw_chain_def(kdw_chain_def_default()) {}
+};
+
+/// A view shape of a chain: non-owning handle (engine pointer + id), cheap to copy.
+class ViewShape {
+public:
+    /// The null handle.
+    ViewShape() noexcept = default;
+    /// Wraps an id of `engine`.
+    ViewShape(kdw_engine* engine, ViewShapeId id) noexcept : engine_(engine), id_(id) {}
+
+    /// The engine this view shape belongs to.
+    kdw_engine* engine() const noexcept { return engine_; }
+    /// The C id.
+    ViewShapeId id() const noexcept { return id_; }
+
+    /// True if the id names a live view shape of its engine (false for null, removed or foreign ids).
+    [[nodiscard]] bool isValid() const noexcept {
+        uint32_t valid = 0;
+        return engine_ != nullptr && id_ != 0 && kdw_view_shape_is_valid(engine_, id_, &valid) == KDW_STATUS_OK &&
+               valid != 0;
+    }
+
+    /// Sets the influence (> 0): large narrows, small widens the cone of directions it acts in.
+    Ret<void> setInfluence(float influence) const {
+        return detail::check(kdw_view_shape_set_influence(engine_, id_, influence));
+    }
+    /// Sets the view direction (view reference frame, non-zero).
+    Ret<void> setDirection(const Vec3& direction) const {
+        return detail::check(kdw_view_shape_set_direction(engine_, id_, &direction));
+    }
+    /// Replaces the joints (as many as the chain has, anchor frame).
+    Ret<void> setJoints(const Transform* joints, uint32_t count) const {
+        return detail::check(kdw_view_shape_set_joints(engine_, id_, joints, count));
+    }
+    /// Replaces the joints (as many as the chain has, anchor frame).
+    Ret<void> setJoints(Span<const Transform> joints) const { return setJoints(joints.data(), joints.size()); }
+    /// Removes the view shape from its chain; this handle (and its copies) become invalid.
+    Ret<void> remove() const { return detail::check(kdw_view_shape_remove(engine_, id_)); }
+
+    /// Same engine and id.
+    friend bool operator==(const ViewShape& a, const ViewShape& b) noexcept {
+        return a.engine_ == b.engine_ && a.id_ == b.id_;
+    }
+    /// Different engine or id.
+    friend bool operator!=(const ViewShape& a, const ViewShape& b) noexcept { return !(a == b); }
+
+private:
+    kdw_engine* engine_ = nullptr;
+    ViewShapeId id_ = 0;
+};
+
+/// A chain (hair strand, ear, tail): non-owning handle (engine pointer + id), cheap to copy. Methods are
+/// const because the handle is a value like an id; they act on the chain inside the engine.
+class ViewDependentPhysicalObject {
+public:
+    /// The null handle.
+    ViewDependentPhysicalObject() noexcept = default;
+    /// Wraps an id of `engine`.
+    ViewDependentPhysicalObject(kdw_engine* engine, ChainId id) noexcept : engine_(engine), id_(id) {}
+
+    /// The engine this chain belongs to.
+    kdw_engine* engine() const noexcept { return engine_; }
+    /// The C id.
+    ChainId id() const noexcept { return id_; }
+
+    /// True if the id names a live chain of its engine (false for null, destroyed or foreign ids).
+    [[nodiscard]] bool isValid() const noexcept {
+        uint32_t valid = 0;
+        return engine_ != nullptr && id_ != 0 && kdw_chain_is_valid(engine_, id_, &valid) == KDW_STATUS_OK &&
+               valid != 0;
+    }
+    /// Destroys the chain and its view shapes; this handle (and its copies) become invalid.
+    Ret<void> destroy() const { return detail::check(kdw_chain_destroy(engine_, id_)); }
+
+    /// The chain's parameters.
+    [[nodiscard]] Ret<ChainDef> def() const {
+        ChainDef def;
+        const kdw_status status = kdw_chain_get_def(engine_, id_, &def);
+        return detail::result(status, def);
+    }
+    /// Replaces the parameters (validated as a whole; nothing changes on error).
+    Ret<void> setDef(const ChainDef& def) const { return detail::check(kdw_chain_set_def(engine_, id_, &def)); }
+    /// Replaces the base shape (same joint count, anchor frame), blended in without injecting momentum.
+    Ret<void> setBaseShape(const Transform* joints, uint32_t count) const {
+        return detail::check(kdw_chain_set_base_shape(engine_, id_, joints, count));
+    }
+    /// Replaces the base shape (same joint count, anchor frame), blended in without injecting momentum.
+    Ret<void> setBaseShape(Span<const Transform> joints) const { return setBaseShape(joints.data(), joints.size()); }
+    /// Puts the chain back to its rest shape, at rest, at the next step.
+    Ret<void> reset() const { return detail::check(kdw_chain_reset(engine_, id_)); }
+
+    /// Number of joints.
+    [[nodiscard]] Ret<uint32_t> jointCount() const {
+        uint32_t count = 0;
+        const kdw_status status = kdw_chain_joint_count(engine_, id_, &count);
+        return detail::result(status, count);
+    }
+    /// World transforms of the joints into `out` (capacity >= joint count); returns how many were written.
+    [[nodiscard]] Ret<uint32_t> readWorld(Transform* out, uint32_t capacity) const {
+        uint32_t written = 0;
+        const kdw_status status = kdw_chain_read_world(engine_, id_, out, capacity, &written);
+        return detail::result(status, written);
+    }
+    /// World transforms of the joints; `out` is resized to the joint count (no allocation if it fits).
+    Ret<void> readWorld(std::vector<Transform>& out) const {
+        return readInto(out, [this](Transform* data, uint32_t capacity, uint32_t* written) {
+            return kdw_chain_read_world(engine_, id_, data, capacity, written);
+        });
+    }
+    /// The current rest shape (blend of the shapes for the last view direction, anchor frame) into `out`;
+    /// returns how many joints were written.
+    [[nodiscard]] Ret<uint32_t> readRestShape(Transform* out, uint32_t capacity) const {
+        uint32_t written = 0;
+        const kdw_status status = kdw_chain_read_rest_shape(engine_, id_, out, capacity, &written);
+        return detail::result(status, written);
+    }
+    /// The current rest shape (anchor frame); `out` is resized to the joint count.
+    Ret<void> readRestShape(std::vector<Transform>& out) const {
+        return readInto(out, [this](Transform* data, uint32_t capacity, uint32_t* written) {
+            return kdw_chain_read_rest_shape(engine_, id_, data, capacity, written);
+        });
+    }
+    /// Kinetic energy of the dynamic joints, J.
+    [[nodiscard]] Ret<float> kineticEnergy() const {
+        float energy = 0.0f;
+        const kdw_status status = kdw_chain_kinetic_energy(engine_, id_, &energy);
+        return detail::result(status, energy);
+    }
+
+    /// Adds a view shape: seen from `direction` (view reference frame, non-zero) the rest shape becomes
+    /// `joints` (as many as the chain has); `influence > 0` sets the width of its cone.
+    Ret<ViewShape> addViewShape(const Vec3& direction, const Transform* joints, uint32_t count,
+                                float influence) const {
+        ViewShapeId id = 0;
+        const kdw_status status = kdw_chain_add_view_shape(engine_, id_, &direction, joints, count, influence, &id);
+        return detail::result(status, ViewShape(engine_, id));
+    }
+    /// Adds a view shape (see the pointer overload).
+    Ret<ViewShape> addViewShape(const Vec3& direction, Span<const Transform> joints, float influence) const {
+        return addViewShape(direction, joints.data(), joints.size(), influence);
+    }
+    /// Number of view shapes.
+    [[nodiscard]] Ret<uint32_t> viewShapeCount() const {
+        uint32_t count = 0;
+        const kdw_status status = kdw_chain_view_shape_count(engine_, id_, &count);
+        return detail::result(status, count);
+    }
+
+    /// Same engine and id.
+    friend bool operator==(const ViewDependentPhysicalObject& a, const ViewDependentPhysicalObject& b) noexcept {
+        return a.engine_ == b.engine_ && a.id_ == b.id_;
+    }
+    /// Different engine or id.
+    friend bool operator!=(const ViewDependentPhysicalObject& a, const ViewDependentPhysicalObject& b) noexcept {
+        return !(a == b);
+    }
+
+private:
+    template <class Read>
+    Ret<void> readInto(std::vector<Transform>& out, Read read) const {
+        uint32_t count = 0;
+        KODAWARI_DETAIL_TRY(detail::check(kdw_chain_joint_count(engine_, id_, &count)));
+        out.resize(count);
+        uint32_t written = 0;
+        return detail::check(read(out.data(), count, &written));
+    }
+
+    kdw_engine* engine_ = nullptr;
+    ChainId id_ = 0;
+};
+
+/// One per character: owns its chains and view shapes. Move-only; the destructor destroys the engine.
+class Engine {
+public:
+    /// An empty engine (falsy); assign one from create().
+    Engine() noexcept = default;
+    /// Takes ownership of an engine made by kdw_engine_create (nullptr gives an empty engine).
+    explicit Engine(kdw_engine* owned) noexcept : handle_(owned) {}
+#ifndef KODAWARI_NO_EXCEPTIONS
+    /// Creates an engine; throws Error on an ABI mismatch or invalid settings.
+    explicit Engine(const EngineDef& def) : Engine(create(def)) {}
+#endif
+    /// Creates an engine after checking kdw_abi_version() == KDW_ABI_VERSION.
+    [[nodiscard]] static Ret<Engine> create(const EngineDef& def = EngineDef()) {
+        if (kdw_abi_version() != KDW_ABI_VERSION) {
+            KODAWARI_DETAIL_TRY(detail::check(kStatusAbiMismatch,
+                                              "the loaded kodawari library has another ABI version than kodawari.h"));
+        }
+        kdw_engine* raw = nullptr;
+        const kdw_status status = kdw_engine_create(&def, &raw);
+        return detail::result(status, Engine(raw));
+    }
+
+    /// Destroys the engine (if any) and everything it owns.
+    ~Engine() {
+        if (handle_ != nullptr) kdw_engine_destroy(handle_);
+    }
+    Engine(const Engine&) = delete;
+    Engine& operator=(const Engine&) = delete;
+    /// Takes over `other`'s engine; `other` becomes empty.
+    Engine(Engine&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
+    /// Destroys the current engine (if any) and takes over `other`'s; `other` becomes empty.
+    Engine& operator=(Engine&& other) noexcept {
+        Engine old(std::move(other));
+        std::swap(handle_, old.handle_);
+        return *this;
+    }
+
+    /// True if this object owns an engine.
+    explicit operator bool() const noexcept { return handle_ != nullptr; }
+    /// The C handle (nullptr if empty); still owned by this object.
+    kdw_engine* handle() const noexcept { return handle_; }
+    /// Gives up ownership: returns the C handle, which the caller must kdw_engine_destroy.
+    [[nodiscard]] kdw_engine* release() noexcept { return std::exchange(handle_, nullptr); }
+
+    /// The current settings.
+    [[nodiscard]] Ret<EngineDef> def() const {
+        EngineDef def;
+        const kdw_status status = kdw_engine_get_def(handle_, &def);
+        return detail::result(status, def);
+    }
+    /// Replaces all settings (validated as a whole; nothing changes on error).
+    Ret<void> setDef(const EngineDef& def) { return detail::check(kdw_engine_set_def(handle_, &def)); }
+    /// World gravity, m/s².
+    [[nodiscard]] Ret<Vec3> gravity() const {
+        EngineDef def;
+        const kdw_status status = kdw_engine_get_def(handle_, &def);
+        return detail::result(status, def.gravity);
+    }
+    /// Sets world gravity, m/s².
+    Ret<void> setGravity(const Vec3& gravity) { return detail::check(kdw_engine_set_gravity(handle_, &gravity)); }
+
+    /// Advances every chain by `dt` s (finite, >= 0), seen from `camera` (world), with the view reference
+    /// joint K at `viewReference` (world).
+    Ret<void> step(float dt, const Vec3& camera, const Transform& viewReference) {
+        return detail::check(kdw_engine_step(handle_, dt, &camera, &viewReference));
+    }
+    /// Sets every chain's anchor for the next step (`count` == chain count, creation order, world space).
+    Ret<void> setAnchors(const Transform* anchors, uint32_t count) {
+        return detail::check(kdw_engine_set_anchors(handle_, anchors, count));
+    }
+    /// Sets every chain's anchor for the next step (one per chain, creation order, world space).
+    Ret<void> setAnchors(Span<const Transform> anchors) { return setAnchors(anchors.data(), anchors.size()); }
+
+    /// Number of chains.
+    [[nodiscard]] Ret<uint32_t> chainCount() const {
+        uint32_t count = 0;
+        const kdw_status status = kdw_engine_chain_count(handle_, &count);
+        return detail::result(status, count);
+    }
+    /// Total number of joints of all chains (the size readWorld needs).
+    [[nodiscard]] Ret<uint32_t> jointCount() const {
+        uint32_t count = 0;
+        const kdw_status status = kdw_engine_joint_count(handle_, &count);
+        return detail::result(status, count);
+    }
+    /// Chain ids in creation order into `out` (capacity >= chain count); returns how many were written.
+    [[nodiscard]] Ret<uint32_t> chainIds(ChainId* out, uint32_t capacity) const {
+        uint32_t written = 0;
+        const kdw_status status = kdw_engine_get_chain_ids(handle_, out, capacity, &written);
+        return detail::result(status, written);
+    }
+    /// Chain ids in creation order; `out` is resized to the chain count (no allocation if it fits).
+    Ret<void> chainIds(std::vector<ChainId>& out) const {
+        return readInto(out, kdw_engine_chain_count, kdw_engine_get_chain_ids);
+    }
+    /// A handle for a chain id of this engine (not checked here; see isValid()).
+    ViewDependentPhysicalObject chain(ChainId id) noexcept { return {handle_, id}; }
+
+    /// World transforms of every joint (chains in creation order, root to tip) into `out`; returns how
+    /// many were written (capacity >= jointCount()).
+    [[nodiscard]] Ret<uint32_t> readWorld(Transform* out, uint32_t capacity) const {
+        uint32_t written = 0;
+        const kdw_status status = kdw_engine_read_world(handle_, out, capacity, &written);
+        return detail::result(status, written);
+    }
+    /// World transforms of every joint; `out` is resized to jointCount() (no allocation if it fits).
+    Ret<void> readWorld(std::vector<Transform>& out) const {
+        return readInto(out, kdw_engine_joint_count, kdw_engine_read_world);
+    }
+    /// Each joint's rotation relative to its parent (Unity's localRotation), in readWorld order, into
+    /// `out`; returns how many were written.
+    [[nodiscard]] Ret<uint32_t> readLocalRotations(Quat* out, uint32_t capacity) const {
+        uint32_t written = 0;
+        const kdw_status status = kdw_engine_read_local_rotations(handle_, out, capacity, &written);
+        return detail::result(status, written);
+    }
+    /// Local rotations in readWorld order; `out` is resized to jointCount() (no allocation if it fits).
+    Ret<void> readLocalRotations(std::vector<Quat>& out) const {
+        return readInto(out, kdw_engine_joint_count, kdw_engine_read_local_rotations);
+    }
+
+    /// Counters: chains, joints, substeps, time dropped, chains asleep.
+    [[nodiscard]] Ret<EngineStats> stats() const {
+        EngineStats stats{};
+        const kdw_status status = kdw_engine_get_stats(handle_, &stats);
+        return detail::result(status, stats);
+    }
+    /// Puts every chain back to its rest shape, at rest, at the next step.
+    Ret<void> reset() { return detail::check(kdw_engine_reset(handle_)); }
+    /// A hash of everything that determines future results (determinism and "unchanged" checks).
+    [[nodiscard]] Ret<uint64_t> stateHash() const {
+        uint64_t hash = 0;
+        const kdw_status status = kdw_engine_state_hash(handle_, &hash);
+        return detail::result(status, hash);
+    }
+
+    /// Creates a chain from its base shape (>= 2 joints, anchor frame, root first).
+    Ret<ViewDependentPhysicalObject> createChain(const ChainDef& def, const Transform* joints, uint32_t count) {
+        ChainId id = 0;
+        const kdw_status status = kdw_chain_create(handle_, &def, joints, count, &id);
+        return detail::result(status, ViewDependentPhysicalObject(handle_, id));
+    }
+    /// Creates a chain from its base shape (>= 2 joints, anchor frame, root first).
+    Ret<ViewDependentPhysicalObject> createChain(const ChainDef& def, Span<const Transform> joints) {
+        return createChain(def, joints.data(), joints.size());
+    }
+
+private:
+    template <class T, class Count, class Read>
+    Ret<void> readInto(std::vector<T>& out, Count count_of, Read read) const {
+        uint32_t count = 0;
+        KODAWARI_DETAIL_TRY(detail::check(count_of(handle_, &count)));
+        out.resize(count);
+        uint32_t written = 0;
+        return detail::check(read(handle_, out.data(), count, &written));
+    }
+
+    kdw_engine* handle_ = nullptr;
+};
+
+}  // inline namespace KODAWARI_DETAIL_MODE
+}  // namespace kodawari
+
+#undef KODAWARI_DETAIL_TRY
+#undef KODAWARI_DETAIL_MODE
+
+#endif  // KODAWARI_HPP

@@ -1,0 +1,20 @@
+// Must NOT compile (with -Werror): every fallible call of bindings/cpp/kodawari.hpp is [[nodiscard]].
+// tests/cpp_bindings.rs compiles it in both modes and expects one "nodiscard" diagnostic per marked line.
+#include "kodawari.hpp"
+
+void discard_everything(kodawari::Engine& engine, kodawari::ViewDependentPhysicalObject chain,
+                        kodawari::ViewShape shape) {
+    engine.chainCount();                     // DISCARD
+    engine.stateHash();                      // DISCARD
+    chain.jointCount();                      // DISCARD
+    chain.isValid();                         // DISCARD
+    kodawari::Engine::create();              // DISCARD
+#ifdef KODAWARI_NO_EXCEPTIONS
+    engine.step(0.0f, {}, {});               // DISCARD
+    engine.reset();                          // DISCARD
+    chain.destroy();                         // DISCARD
+    shape.remove();                          // DISCARD
+#else
+    (void)shape;
+#endif
+}

@@ -1,0 +1,390 @@
+// Tests of the C++ binding bindings/cpp/kodawari.hpp (exceptions mode), linked dynamically against
+// libkodawari.so together with test_no_exceptions.cpp (the KODAWARI_NO_EXCEPTIONS mode, built with
+// -fno-exceptions). Built and run by tests/cpp_bindings.rs (`cargo test --test cpp_bindings`).
+// The last line printed is "N passed, M failed"; the exit status is non-zero on any failure.
+
+#include <dlfcn.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "harness.hpp"
+#include "kodawari.hpp"
+
+// Counts every kdw_engine_destroy the binding makes, then forwards to the library's. The executable's
+// definition takes precedence over the shared library's (ELF symbol interposition), so the destructor's
+// calls land here and "destroyed exactly once" can be checked exactly.
+extern "C" kdw_status kdw_engine_destroy(kdw_engine* engine) {
+    using Destroy = kdw_status (*)(kdw_engine*);
+    static const Destroy library_destroy = reinterpret_cast<Destroy>(dlsym(RTLD_NEXT, "kdw_engine_destroy"));
+    ++harness::counters().engine_destroy_calls;
+    harness::counters().last_destroyed = engine;
+    return library_destroy != nullptr ? library_destroy(engine) : KDW_STATUS_PANIC;
+}
+
+// Lets a test pretend the loaded library has another ABI version.
+extern "C" uint32_t kdw_abi_version(void) {
+    using Version = uint32_t (*)(void);
+    static const Version library_version = reinterpret_cast<Version>(dlsym(RTLD_NEXT, "kdw_abi_version"));
+    if (harness::counters().fake_abi_version != 0) return harness::counters().fake_abi_version;
+    return library_version != nullptr ? library_version() : 0;
+}
+
+void run_no_exception_tests();  // test_no_exceptions.cpp
+
+namespace {
+
+using kodawari::ChainDef;
+using kodawari::Engine;
+using kodawari::EngineDef;
+using kodawari::Transform;
+using kodawari::ViewDependentPhysicalObject;
+using kodawari::ViewShape;
+
+// `expression` must throw kodawari::Error with `expected` status and a non-empty message.
+#define CHECK_THROWS(expression, expected)                                         \
+    do {                                                                           \
+        kdw_status thrown = KDW_STATUS_OK;                                         \
+        std::string message;                                                       \
+        try {                                                                      \
+            (void)(expression);                                                    \
+        } catch (const kodawari::Error& error) {                                   \
+            thrown = error.status();                                               \
+            message = error.message();                                             \
+        }                                                                          \
+        CHECK(thrown == (expected));                                               \
+        CHECK(!message.empty());                                                   \
+    } while (0)
+
+// Same methods, plain values: in exceptions mode fallible calls return T / void.
+static_assert(std::is_same_v<decltype(std::declval<Engine&>().chainCount()), uint32_t>);
+static_assert(std::is_same_v<decltype(std::declval<Engine&>().step(0.0f, {}, {})), void>);
+static_assert(std::is_same_v<kodawari::Ret<ViewShape>, ViewShape>);
+
+// Ownership: move-only engine, cheap copyable handles.
+static_assert(!std::is_copy_constructible_v<Engine> && !std::is_copy_assignable_v<Engine>);
+static_assert(std::is_nothrow_move_constructible_v<Engine> && std::is_nothrow_move_assignable_v<Engine>);
+static_assert(std::is_nothrow_destructible_v<Engine>);
+static_assert(std::is_constructible_v<bool, Engine> && !std::is_convertible_v<Engine, bool>);
+static_assert(std::is_trivially_copyable_v<ViewDependentPhysicalObject> && std::is_trivially_copyable_v<ViewShape>);
+static_assert(std::is_base_of_v<std::runtime_error, kodawari::Error>);
+static_assert(std::is_base_of_v<kdw_engine_def, EngineDef> && sizeof(EngineDef) == sizeof(kdw_engine_def));
+static_assert(std::is_base_of_v<kdw_chain_def, ChainDef> && sizeof(ChainDef) == sizeof(kdw_chain_def));
+
+ChainDef ahoge_def(const harness::Scene& scene) {
+    ChainDef def;
+    def.stiffness = scene.stiffness;
+    return def;
+}
+
+void test_defaults_and_versions() {
+    const EngineDef engine_def;
+    const kdw_engine_def c_engine_def = kdw_engine_def_default();
+    CHECK(std::memcmp(&engine_def, &c_engine_def, sizeof c_engine_def) == 0);
+    const ChainDef chain_def;
+    const kdw_chain_def c_chain_def = kdw_chain_def_default();
+    CHECK(std::memcmp(&chain_def, &c_chain_def, sizeof c_chain_def) == 0);
+    CHECK(chain_def.struct_size == sizeof(kdw_chain_def));
+    CHECK(kodawari::abiVersion() == KDW_ABI_VERSION);
+    CHECK(std::string(kodawari::versionString()).size() > 0);
+    CHECK(std::string(kodawari::statusString(KDW_STATUS_INVALID_ID)) == kdw_status_str(KDW_STATUS_INVALID_ID));
+}
+
+void test_abi_mismatch_refuses_to_create() {
+    const int destroys_before = harness::counters().engine_destroy_calls;
+    harness::counters().fake_abi_version = KDW_ABI_VERSION + 1;
+    bool threw = false;
+    try {
+        Engine engine{EngineDef()};
+    } catch (const kodawari::Error& error) {
+        threw = error.status() == kodawari::kStatusAbiMismatch && !error.message().empty();
+    }
+    harness::counters().fake_abi_version = 0;
+    CHECK(threw);
+    CHECK(harness::counters().engine_destroy_calls == destroys_before);  // nothing was created
+    CHECK(Engine::create());
+}
+
+void test_life_cycle() {
+    const harness::Scene scene = harness::ahoge_scene();
+    const int destroys_before = harness::counters().engine_destroy_calls;
+    kdw_engine* raw = nullptr;
+    {
+        Engine engine{EngineDef()};
+        raw = engine.handle();
+        CHECK(engine && raw != nullptr);
+        CHECK(engine.chainCount() == 0 && engine.jointCount() == 0);
+
+        ViewDependentPhysicalObject ahoge = engine.createChain(ahoge_def(scene), scene.base);  // C array
+        CHECK(ahoge.isValid() && ahoge.engine() == raw && ahoge.id() != 0);
+        CHECK(engine.chain(ahoge.id()) == ahoge);
+        CHECK(ahoge.jointCount() == harness::kJoints && engine.jointCount() == harness::kJoints);
+        CHECK(ahoge.def().stiffness == scene.stiffness);
+
+        const std::vector<Transform> tail_shape(scene.base, scene.base + harness::kJoints);  // std::vector
+        ViewDependentPhysicalObject tail = engine.createChain(ChainDef(), tail_shape);
+        CHECK(tail != ahoge && tail.isValid());
+        CHECK(engine.chainCount() == 2 && engine.jointCount() == 2 * harness::kJoints);
+        std::vector<kodawari::ChainId> ids;
+        engine.chainIds(ids);
+        CHECK(ids.size() == 2 && ids[0] == ahoge.id() && ids[1] == tail.id());
+        std::array<kodawari::ChainId, 4> id_buffer{};
+        CHECK(engine.chainIds(id_buffer.data(), 4) == 2 && id_buffer[1] == tail.id());
+
+        ViewShape left = ahoge.addViewShape(scene.from_left, scene.left, 1.0f);
+        ViewShape right = ahoge.addViewShape(scene.from_right, scene.right, harness::kJoints, 1.0f);  // pointer
+        CHECK(left != right && ahoge.viewShapeCount() == 2 && tail.viewShapeCount() == 0);
+        left.setInfluence(2.0f);
+        left.setDirection(kodawari::Vec3{-1.0f, 0.2f, 0.0f});
+        right.setJoints(scene.right);
+
+        // Settings round trips.
+        EngineDef engine_def = engine.def();
+        engine_def.iterations = 4;
+        engine.setDef(engine_def);
+        CHECK(engine.def().iterations == 4);
+        engine.setGravity({0.0f, -3.0f, 0.0f});
+        CHECK(engine.gravity().y == -3.0f);
+        ChainDef tail_def = tail.def();
+        tail_def.anchor = KDW_ANCHOR_OWN;
+        tail_def.damping = 2.0f;
+        tail.setDef(tail_def);
+        CHECK(tail.def().anchor == KDW_ANCHOR_OWN && tail.def().damping == 2.0f);
+
+        // A few frames, anchors included; read-backs into reused vectors.
+        const std::array<Transform, 2> anchors{scene.head, Transform{{0.3f, 1.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}}};
+        std::vector<Transform> world, rest;
+        std::vector<kodawari::Quat> local;
+        for (int frame = 0; frame < 10; ++frame) {
+            engine.setAnchors(anchors);
+            engine.step(harness::kDt, harness::orbit_camera(frame), scene.head);
+            engine.readWorld(world);
+            engine.readLocalRotations(local);
+        }
+        CHECK(world.size() == 2 * harness::kJoints && local.size() == world.size());
+        CHECK(std::isfinite(world.back().position.x) && std::fabs(world.back().position.x - 0.3f) < 0.5f);
+        std::vector<Transform> tail_world;
+        tail.readWorld(tail_world);
+        CHECK(tail_world.size() == harness::kJoints);
+        CHECK(std::memcmp(tail_world.data(), &world[harness::kJoints], harness::kJoints * sizeof(Transform)) == 0);
+        ahoge.readRestShape(rest);
+        CHECK(rest.size() == harness::kJoints);
+        Transform rest_buffer[harness::kJoints];
+        CHECK(ahoge.readRestShape(rest_buffer, harness::kJoints) == harness::kJoints);
+        CHECK(ahoge.kineticEnergy() >= 0.0f);
+        const kodawari::EngineStats stats = engine.stats();
+        CHECK(stats.chain_count == 2 && stats.joint_count == 2 * harness::kJoints && stats.substeps_total > 0);
+
+        ahoge.setBaseShape(scene.left);
+        ahoge.reset();
+        engine.reset();
+        right.remove();
+        CHECK(ahoge.viewShapeCount() == 1);
+        tail.destroy();
+        CHECK(!tail.isValid() && engine.chainCount() == 1);
+        CHECK(harness::counters().engine_destroy_calls == destroys_before);
+    }
+    CHECK(harness::counters().engine_destroy_calls == destroys_before + 1);
+    CHECK(harness::counters().last_destroyed == raw);
+}
+
+void test_moves_destroy_exactly_once() {
+    const harness::Scene scene = harness::ahoge_scene();
+    const int before = harness::counters().engine_destroy_calls;
+    kdw_engine* raw = nullptr;
+    {
+        Engine a{EngineDef()};
+        raw = a.handle();
+        const ViewDependentPhysicalObject ahoge = a.createChain(ahoge_def(scene), scene.base);
+
+        Engine b(std::move(a));  // move construction
+        CHECK(!a && a.handle() == nullptr && b && b.handle() == raw);
+        CHECK(ahoge.isValid());  // handles hold the C engine, not the C++ object
+
+        Engine c;
+        CHECK(!c && c.handle() == nullptr);
+        c = std::move(b);  // move assignment into an empty engine
+        CHECK(!b && c.handle() == raw);
+        c.step(harness::kDt, harness::orbit_camera(0), scene.head);
+        CHECK(harness::counters().engine_destroy_calls == before);
+
+        Engine d{EngineDef()};
+        kdw_engine* const raw_d = d.handle();
+        d = std::move(c);  // the engine d owned is destroyed, once
+        CHECK(harness::counters().engine_destroy_calls == before + 1 && harness::counters().last_destroyed == raw_d);
+        CHECK(!c && d.handle() == raw && ahoge.jointCount() == harness::kJoints);
+
+        Engine& alias = d;
+        d = std::move(alias);  // self-move keeps the engine
+        CHECK(d.handle() == raw && harness::counters().engine_destroy_calls == before + 1);
+
+        // release() hands the C handle over; adopting it again gives it back to RAII.
+        kdw_engine* const released = d.release();
+        CHECK(!d && released == raw);
+        Engine adopted(released);
+        CHECK(adopted.handle() == raw && ahoge.isValid());
+    }
+    // a, b, c, d were emptied by moves: only `adopted` destroyed the engine.
+    CHECK(harness::counters().engine_destroy_calls == before + 2);
+    CHECK(harness::counters().last_destroyed == raw);
+}
+
+void test_invalid_calls_throw_and_leave_state_unchanged() {
+    const harness::Scene scene = harness::ahoge_scene();
+    Engine engine{EngineDef()};
+    const ViewDependentPhysicalObject ahoge = engine.createChain(ahoge_def(scene), scene.base);
+    const ViewShape left = ahoge.addViewShape(scene.from_left, scene.left, 1.0f);
+    for (int frame = 0; frame < 30; ++frame) engine.step(harness::kDt, harness::orbit_camera(frame), scene.head);
+    const uint64_t before = engine.stateHash();
+
+    ChainDef too_stiff = ahoge.def();
+    too_stiff.stiffness = 2.0f;
+    CHECK_THROWS(ahoge.setDef(too_stiff), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK(engine.stateHash() == before && ahoge.def().stiffness == scene.stiffness);
+
+    CHECK_THROWS(engine.step(std::numeric_limits<float>::quiet_NaN(), harness::orbit_camera(30), scene.head),
+                 KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_THROWS(engine.step(-1.0f, harness::orbit_camera(30), scene.head), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK(engine.stateHash() == before);
+
+    EngineDef no_iterations;
+    no_iterations.iterations = 0;
+    CHECK_THROWS(engine.setDef(no_iterations), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_THROWS(Engine{no_iterations}, KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_THROWS(engine.createChain(ChainDef(), scene.base, 1), KDW_STATUS_INVALID_ARGUMENT);  // n < 2
+    CHECK_THROWS(left.setInfluence(0.0f), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_THROWS(left.setDirection(kodawari::Vec3{0.0f, 0.0f, 0.0f}), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_THROWS(ahoge.setBaseShape(scene.base, 3), KDW_STATUS_INVALID_ARGUMENT);  // wrong joint count
+    ChainDef wrong_size;
+    wrong_size.struct_size = 4;
+    CHECK_THROWS(ahoge.setDef(wrong_size), KDW_STATUS_STRUCT_SIZE_MISMATCH);
+    Transform small[2];
+    CHECK_THROWS(engine.readWorld(small, 2), KDW_STATUS_BUFFER_TOO_SMALL);
+    CHECK_THROWS(engine.setAnchors(nullptr, 0), KDW_STATUS_INVALID_ARGUMENT);  // one anchor per chain
+    CHECK(engine.stateHash() == before && engine.chainCount() == 1 && ahoge.viewShapeCount() == 1);
+
+    // The error carries status and message; what() says both.
+    try {
+        ahoge.setDef(too_stiff);
+        CHECK(false);
+    } catch (const std::runtime_error& error) {
+        const auto& kodawari_error = dynamic_cast<const kodawari::Error&>(error);
+        CHECK(kodawari_error.status() == KDW_STATUS_INVALID_ARGUMENT);
+        CHECK(std::string(error.what()).find(kodawari_error.message()) != std::string::npos);
+        CHECK(std::string(error.what()).find(kdw_status_str(KDW_STATUS_INVALID_ARGUMENT)) == 0);
+    }
+
+    // Result::value() on a failure throws the same Error in exceptions mode.
+    const kodawari::Result<int> failed(kodawari::Status(KDW_STATUS_INVALID_ID, "gone"));
+    CHECK(!failed.ok() && failed.valueOr(7) == 7);
+    CHECK_THROWS(failed.value(), KDW_STATUS_INVALID_ID);
+
+    // An empty (moved-from or default) engine reports a null pointer instead of crashing.
+    Engine empty;
+    CHECK_THROWS(empty.chainCount(), KDW_STATUS_NULL_POINTER);
+}
+
+void test_orbit_scene_matches_plain_c() {
+    const harness::OrbitRun reference = harness::c_reference_orbit();
+    CHECK(reference.ok);
+
+    const harness::Scene scene = harness::ahoge_scene();
+    Engine engine = Engine::create();
+    const ViewDependentPhysicalObject ahoge = engine.createChain(ahoge_def(scene), scene.base);
+    const ViewShape left = ahoge.addViewShape(scene.from_left, scene.left, 1.0f);
+    const ViewShape right = ahoge.addViewShape(scene.from_right, scene.right, 1.0f);
+    CHECK(left != right);
+
+    std::vector<Transform> frames;
+    std::vector<Transform> joints(harness::kJoints);
+    const Transform* const storage = joints.data();
+    for (int frame = 0; frame < harness::kFrames; ++frame) {
+        engine.step(harness::kDt, harness::orbit_camera(frame), scene.head);
+        engine.readWorld(joints);
+        CHECK(joints.data() == storage);  // the vector already had the size: no reallocation
+        frames.insert(frames.end(), joints.begin(), joints.end());
+    }
+    std::vector<kodawari::Quat> local;
+    engine.readLocalRotations(local);
+    std::vector<Transform> rest;
+    ahoge.readRestShape(rest);
+
+    CHECK(engine.stateHash() == reference.hash);
+    CHECK(harness::same_bits(frames, reference.frames));
+    CHECK(harness::same_bits(local, reference.local_rotations));
+    CHECK(harness::same_bits(rest, reference.rest_shape));
+    // The scene did something: seen from the side (frame 60) the tip leans away from the base shape.
+    CHECK(std::fabs(frames[60 * harness::kJoints + harness::kJoints - 1].position.x) > 1e-3f);
+    std::printf("     orbit: state hash %016llx, C++ == C bit for bit\n", static_cast<unsigned long long>(reference.hash));
+}
+
+void test_removed_and_destroyed_handles() {
+    const harness::Scene scene = harness::ahoge_scene();
+    Engine engine{EngineDef()};
+    const ViewDependentPhysicalObject ahoge = engine.createChain(ahoge_def(scene), scene.base);
+    const ViewDependentPhysicalObject other = engine.createChain(ChainDef(), scene.base);
+    const ViewShape left = ahoge.addViewShape(scene.from_left, scene.left, 1.0f);
+    const ViewShape right = ahoge.addViewShape(scene.from_right, scene.right, 1.0f);
+    const ViewShape left_copy = left;
+    CHECK(left_copy == left);
+    CHECK(left.isValid() && right.isValid());
+
+    left.remove();
+    CHECK(!left.isValid() && !left_copy.isValid() && right.isValid());
+    CHECK(ahoge.viewShapeCount() == 1);
+    CHECK_THROWS(left.setInfluence(2.0f), KDW_STATUS_INVALID_ID);
+    CHECK_THROWS(left_copy.remove(), KDW_STATUS_INVALID_ID);
+    CHECK_THROWS(left.setJoints(scene.left), KDW_STATUS_INVALID_ID);
+    right.setInfluence(2.0f);  // the other view shape is untouched
+
+    const ViewDependentPhysicalObject ahoge_copy = ahoge;
+    ahoge.destroy();
+    CHECK(!ahoge.isValid() && !ahoge_copy.isValid() && other.isValid());
+    CHECK(engine.chainCount() == 1 && engine.chain(other.id()) == other);
+    CHECK_THROWS(ahoge_copy.jointCount(), KDW_STATUS_INVALID_ID);
+    CHECK_THROWS(ahoge.def(), KDW_STATUS_INVALID_ID);
+    CHECK_THROWS(ahoge.kineticEnergy(), KDW_STATUS_INVALID_ID);
+    std::vector<Transform> world;
+    CHECK_THROWS(ahoge.readWorld(world), KDW_STATUS_INVALID_ID);
+    CHECK_THROWS(ahoge.addViewShape(scene.from_left, scene.left, 1.0f), KDW_STATUS_INVALID_ID);
+    CHECK_THROWS(ahoge.destroy(), KDW_STATUS_INVALID_ID);
+    CHECK_THROWS(right.setInfluence(1.0f), KDW_STATUS_INVALID_ID);  // died with its chain
+
+    // Null handles and ids of another engine are rejected the same way.
+    CHECK(!ViewDependentPhysicalObject().isValid());
+    CHECK_THROWS(engine.chain(0).jointCount(), KDW_STATUS_INVALID_ID);
+    Engine stranger{EngineDef()};
+    CHECK(!stranger.chain(other.id()).isValid());
+    CHECK_THROWS(stranger.chain(other.id()).reset(), KDW_STATUS_INVALID_ID);
+    other.reset();
+}
+
+// Runs a test; an unexpected exception fails it.
+#define RUN(test)                                                                          \
+    harness::run(#test, [] {                                                               \
+        try {                                                                              \
+            test();                                                                        \
+        } catch (const std::exception& error) {                                            \
+            harness::fail(__FILE__, __LINE__, (std::string("unexpected exception: ") + error.what()).c_str()); \
+        }                                                                                  \
+    })
+
+}  // namespace
+
+int main() {
+    RUN(test_defaults_and_versions);
+    RUN(test_abi_mismatch_refuses_to_create);
+    RUN(test_life_cycle);
+    RUN(test_moves_destroy_exactly_once);
+    RUN(test_invalid_calls_throw_and_leave_state_unchanged);
+    RUN(test_orbit_scene_matches_plain_c);
+    RUN(test_removed_and_destroyed_handles);
+    run_no_exception_tests();
+    std::printf("%d passed, %d failed\n", harness::counters().passed, harness::counters().failed);
+    return harness::counters().failed == 0 ? 0 : 1;
+}

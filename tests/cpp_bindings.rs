@@ -153,6 +153,9 @@ fn cpp_readme_example_builds_and_runs() {
     compile(command, "bindings/cpp/example.cpp");
     let stdout = run(&binary);
     assert_eq!(stdout.lines().filter(|line| line.starts_with("frame ")).count(), 5, "five progress lines");
+    let text = std::fs::read_to_string(source("bindings/cpp/example.cpp")).unwrap();
+    let readme = std::fs::read_to_string(source("README.md")).unwrap();
+    assert!(readme.contains(&text), "README.md must quote bindings/cpp/example.cpp verbatim");
 }
 
 /// Lines of `discard_results.cpp` marked `// DISCARD` that are compiled in the given mode.

@@ -175,7 +175,7 @@ fn momentum_suppression_tames_orbiting_camera() {
         let (peak_on, residual_on, track_on) = run(stiffness, 1.0);
         let (peak_off, residual_off, track_off) = run(stiffness, 0.0);
         println!(
-            "stiffness {stiffness}: peak KE on/off {peak_on:.3e}/{peak_off:.3e} (ratio {:.3}), residual KE ratio {:.3}, tracking error on/off {track_on:.4}/{track_off:.4} chain lengths",
+            "stiffness {stiffness}: peak KE on/off {peak_on:.3e}/{peak_off:.3e} (ratio {:.2e}), residual KE ratio {:.2e}, tracking error on/off {track_on:.4}/{track_off:.4} chain lengths",
             peak_on / peak_off,
             residual_on / residual_off
         );

@@ -15,6 +15,20 @@
 #include <stdint.h>
 #include <stddef.h>
 
+// `kdw_stroke_camera.projection`: a pinhole camera; `vertical_fov` is used.
+#define KDW_PROJECTION_PERSPECTIVE 0
+
+// `kdw_stroke_camera.projection`: a parallel projection; `orthographic_half_height` is used.
+#define KDW_PROJECTION_ORTHOGRAPHIC 1
+
+// `kdw_stroke_camera.forward_axis`: the camera looks along its local -Z (right-handed, Y up: OpenGL, glTF,
+// Blender, Godot).
+#define KDW_CAMERA_FORWARD_NEGATIVE_Z 0
+
+// `kdw_stroke_camera.forward_axis`: the camera looks along its local +Z (Unity: pass
+// `Camera.transform.position` and `.rotation` unchanged).
+#define KDW_CAMERA_FORWARD_POSITIVE_Z 1
+
 // The chain's anchor is the view reference joint K given with each step.
 #define KDW_ANCHOR_VIEW_REFERENCE 0
 
@@ -120,6 +134,39 @@ typedef struct kdw_engine_stats {
     // Simulated seconds advanced in total.
     double simulated_time;
 } kdw_engine_stats;
+
+// The camera a stroke was drawn in; obtain defaults from `kdw_stroke_camera_default()`.
+//
+// Screen right is `rotation * (1, 0, 0)`, screen up `rotation * (0, 1, 0)`, and the camera looks along
+// `rotation * (0, 0, -1)` or `rotation * (0, 0, 1)` (`forward_axis`). Pixels have their origin at the
+// viewport's top-left corner, x right, y **down**; pixels are square (the aspect ratio follows from the
+// viewport size).
+typedef struct kdw_stroke_camera {
+    // `sizeof(kdw_stroke_camera)`.
+    uint32_t struct_size;
+    // World position: the eye of a perspective camera, the centre of an orthographic one. Default origin.
+    struct kdw_vec3 position;
+    // World rotation (need not be unit). Default identity.
+    struct kdw_quat rotation;
+    // `KDW_PROJECTION_PERSPECTIVE` (default) or `KDW_PROJECTION_ORTHOGRAPHIC`.
+    uint32_t projection;
+    // `KDW_CAMERA_FORWARD_NEGATIVE_Z` (default) or `KDW_CAMERA_FORWARD_POSITIVE_Z`.
+    uint32_t forward_axis;
+    // Vertical field of view, radians, in (0, pi) (perspective only). Default pi/3 (60°, Unity's default).
+    float vertical_fov;
+    // Half the viewport's height in metres, > 0 (orthographic only; Unity's `orthographicSize`). Default 5.
+    float orthographic_half_height;
+    // Viewport width in pixels, > 0. Default 1920.
+    float viewport_width;
+    // Viewport height in pixels, > 0. Default 1080.
+    float viewport_height;
+} kdw_stroke_camera;
+
+// A 2D point, e.g. a pixel position: the layout of Unity's `Vector2`.
+typedef struct kdw_vec2 {
+    float x;
+    float y;
+} kdw_vec2;
 
 // A view shape of a chain. 0 is the null id.
 typedef uint64_t kdw_view_shape_id;
@@ -242,6 +289,21 @@ kdw_status kdw_engine_step(struct kdw_engine *engine,
                            const struct kdw_vec3 *camera_position,
                            const struct kdw_transform *view_reference);
 
+// A whole frame in one call, for hosts that pay per native call (Unity): sets the anchors (as
+// `kdw_engine_set_anchors`; `anchor_count` must equal the chain count), steps (as `kdw_engine_step`), and
+// writes every joint's local rotation (as `kdw_engine_read_local_rotations`; `capacity` must be at least
+// the joint count). Everything is validated before anything changes; with `dt == 0` only the anchors are
+// stored.
+kdw_status kdw_engine_step_and_read(struct kdw_engine *engine,
+                                    float dt,
+                                    const struct kdw_vec3 *camera_position,
+                                    const struct kdw_transform *view_reference,
+                                    const struct kdw_transform *anchors,
+                                    uint32_t anchor_count,
+                                    struct kdw_quat *out_local_rotations,
+                                    uint32_t capacity,
+                                    uint32_t *out_written);
+
 // Sets every chain's anchor for the next step: `count` must equal the chain count, entry i belongs to
 // the i-th chain in creation order (entries of chains anchored to the view reference are checked but
 // unused). World space. Interpolated across the substeps of the next step.
@@ -286,6 +348,45 @@ kdw_status kdw_engine_reset(struct kdw_engine *engine);
 // A hash of everything that determines future results. Equal hashes after equal calls show determinism;
 // an unchanged hash after a rejected call shows the engine was left untouched.
 kdw_status kdw_engine_state_hash(const struct kdw_engine *engine, uint64_t *out_hash);
+
+// Default stroke camera: at the origin, identity rotation (looking along -Z), perspective with a 60°
+// vertical field of view, 1920 x 1080 pixels (orthographic half-height 5 m if switched to orthographic).
+struct kdw_stroke_camera kdw_stroke_camera_default(void);
+
+// Projects a world point to pixels (origin top-left, y down), e.g. to draw a chain under the stroke.
+// `KDW_STATUS_INVALID_ARGUMENT` for a point on or behind the plane of a perspective camera's eye.
+kdw_status kdw_stroke_camera_project(const struct kdw_stroke_camera *camera,
+                                     const struct kdw_vec3 *point,
+                                     struct kdw_vec2 *out_pixel);
+
+// The sketch tool: a new shape for a chain whose projection through `camera` follows a stroke.
+//
+// Inputs, all world space: the chain as it is now (`current_world_joints`, `joint_count >= 2`, root first),
+// its anchor bone (`anchor_world`: the frame of the result), the view reference joint K
+// (`view_reference_world`), and the stroke (`stroke_pixels`, root to tip, pixels with the origin top-left
+// and y down, at least 2 distinct points; consecutive duplicates are ignored).
+//
+// Writes `joint_count` transforms in the anchor frame to `out_anchor_joints` (`capacity >= joint_count`,
+// else `KDW_STATUS_BUFFER_TOO_SMALL`) and the unit direction from K to the camera in K's frame to
+// `*out_view_direction`: pass both to `kdw_chain_add_view_shape`. The result keeps the root's position and
+// every segment length; the stroke is translated so it starts at the projected root. Arc length along the
+// stroke places the joints (shared by the segments in proportion to their current projected lengths);
+// each joint lies on the ray through its stroke point, at the depth nearest to the current shape's where
+// the ray allows two. A stroke longer than the chain can reach is followed from its start as far as the
+// chain reaches. Rotations are swung to the new segments, keeping their twist.
+//
+// `KDW_STATUS_INVALID_ARGUMENT`: fewer than 2 distinct stroke points, fewer than 2 joints, a zero-length
+// segment, a non-finite value or null rotation, an invalid camera, or a root behind a perspective camera.
+kdw_status kdw_shape_from_stroke(const struct kdw_stroke_camera *camera,
+                                 const struct kdw_transform *current_world_joints,
+                                 uint32_t joint_count,
+                                 const struct kdw_transform *anchor_world,
+                                 const struct kdw_transform *view_reference_world,
+                                 const struct kdw_vec2 *stroke_pixels,
+                                 uint32_t point_count,
+                                 struct kdw_transform *out_anchor_joints,
+                                 uint32_t capacity,
+                                 struct kdw_vec3 *out_view_direction);
 
 // A static, NUL-terminated description of `status` ("unknown status" for values this library never
 // returns). Never NULL.

@@ -4,6 +4,7 @@
 //   kodawari::ViewDependentPhysicalObject a chain: non-owning handle (engine pointer + kdw_chain_id)
 //   kodawari::ViewShape                   a view shape of a chain: non-owning handle
 //   kodawari::EngineDef / ChainDef        the C def structs, initialised to the library defaults
+//   kodawari::StrokeCamera, shapeFromStroke()  the sketch tool: a screen-space stroke -> a chain shape
 //
 // Errors: by default every failing call throws kodawari::Error (status + the library's message). Define
 // KODAWARI_NO_EXCEPTIONS before including this header to get no throws at all: the same methods then
@@ -51,6 +52,7 @@ using Transform = kdw_transform;
 using ChainId = kdw_chain_id;
 using ViewShapeId = kdw_view_shape_id;
 using EngineStats = kdw_engine_stats;
+using Vec2 = kdw_vec2;
 
 /// The loaded library's ABI version differs from the header's.
 inline constexpr kdw_status kStatusAbiMismatch = KDW_STATUS_ABI_MISMATCH;
@@ -259,6 +261,46 @@ struct ChainDef : kdw_chain_def {
     ChainDef() noexcept : kdw_chain_def(kdw_chain_def_default()) {}
 };
 
+/// The camera a stroke was drawn in, initialised to kdw_stroke_camera_default() (perspective, 60° vertical
+/// field of view, 1920 x 1080 pixels, looking along its local -Z; set forwardAxis to
+/// KDW_CAMERA_FORWARD_POSITIVE_Z for Unity's position and rotation). Pixels: origin top-left, y down.
+struct StrokeCamera : kdw_stroke_camera {
+    /// The library defaults.
+    StrokeCamera() noexcept : kdw_stroke_camera(kdw_stroke_camera_default()) {}
+    /// Pixel position of a world point; fails for a point on or behind a perspective camera's eye plane.
+    [[nodiscard]] Ret<Vec2> project(const Vec3& point) const {
+        Vec2 pixel{};
+        const kdw_status status = kdw_stroke_camera_project(this, &point, &pixel);
+        return detail::result(status, pixel);
+    }
+};
+
+/// A chain shape drawn as a stroke (shapeFromStroke): pass it to ViewDependentPhysicalObject::addViewShape.
+struct StrokeShape {
+    /// The new joints in the anchor frame, as many as the chain has.
+    std::vector<Transform> joints;
+    /// Unit direction from the view reference joint to the camera, in the joint's frame.
+    Vec3 viewDirection{};
+};
+
+/// The sketch tool (kdw_shape_from_stroke): a shape for a chain whose projection through `camera` follows
+/// `strokePixels` (root to tip, >= 2 distinct points, moved to start at the projected root), keeping the
+/// root and every segment length; depth comes from the current shape where the stroke cannot tell it.
+/// `currentWorldJoints` (>= 2), `anchorWorld` (the frame of the result) and `viewReferenceWorld` are world
+/// transforms.
+[[nodiscard]] inline Ret<StrokeShape> shapeFromStroke(const StrokeCamera& camera,
+                                                      Span<const Transform> currentWorldJoints,
+                                                      const Transform& anchorWorld,
+                                                      const Transform& viewReferenceWorld,
+                                                      Span<const Vec2> strokePixels) {
+    StrokeShape shape;
+    shape.joints.resize(currentWorldJoints.size());
+    const kdw_status status = kdw_shape_from_stroke(
+        &camera, currentWorldJoints.data(), currentWorldJoints.size(), &anchorWorld, &viewReferenceWorld,
+        strokePixels.data(), strokePixels.size(), shape.joints.data(), currentWorldJoints.size(), &shape.viewDirection);
+    return detail::result(status, std::move(shape));
+}
+
 /// A view shape of a chain: non-owning handle (engine pointer + id), cheap to copy.
 class ViewShape {
 public:
@@ -397,6 +439,11 @@ public:
     /// Adds a view shape (see the pointer overload).
     Ret<ViewShape> addViewShape(const Vec3& direction, Span<const Transform> joints, float influence) const {
         return addViewShape(direction, joints.data(), joints.size(), influence);
+    }
+    /// Adds a sketched shape (shapeFromStroke) as a view shape seen from its camera's direction.
+    Ret<ViewShape> addViewShape(const StrokeShape& shape, float influence) const {
+        return addViewShape(shape.viewDirection, shape.joints.data(), static_cast<uint32_t>(shape.joints.size()),
+                            influence);
     }
     /// Number of view shapes.
     [[nodiscard]] Ret<uint32_t> viewShapeCount() const {
@@ -547,6 +594,17 @@ public:
     /// Local rotations in readWorld order; `out` is resized to jointCount() (no allocation if it fits).
     Ret<void> readLocalRotations(std::vector<Quat>& out) const {
         return readInto(out, kdw_engine_joint_count, kdw_engine_read_local_rotations);
+    }
+
+    /// A whole frame in one native call: anchors (one per chain), step, local rotations out (`capacity` >=
+    /// jointCount()). Nothing changes unless every input is valid. Returns how many rotations were written.
+    Ret<uint32_t> stepAndReadLocalRotations(float dt, const Vec3& camera, const Transform& viewReference,
+                                            const Transform* anchors, uint32_t anchorCount, Quat* out,
+                                            uint32_t capacity) {
+        uint32_t written = 0;
+        const kdw_status status = kdw_engine_step_and_read(handle_, dt, &camera, &viewReference, anchors, anchorCount,
+                                                           out, capacity, &written);
+        return detail::result(status, written);
     }
 
     /// Counters: chains, joints, substeps, time dropped, chains asleep.

@@ -286,18 +286,29 @@ impl Engine {
     /// `camera` and the view reference joint K at `view_reference` (world space). Inputs are validated
     /// before anything changes; `dt == 0` changes nothing.
     pub fn step(&mut self, dt: f32, camera: Vec3, view_reference: Transform) -> Result<()> {
-        if !(dt.is_finite() && dt >= 0.0) {
-            return Err(Error::invalid_argument(format!("dt must be finite and >= 0, got {dt}")));
+        let k = validate_step(dt, camera, &view_reference)?;
+        if dt > 0.0 {
+            self.advance(dt, camera, k);
         }
-        if !camera.is_finite() {
-            return Err(Error::invalid_argument("camera position must be finite"));
-        }
-        let k =
-            validate_transform(&view_reference).map_err(|e| Error::invalid_argument(format!("view reference: {e}")))?;
-        if dt == 0.0 {
-            return Ok(());
-        }
+        Ok(())
+    }
 
+    /// A whole frame in one call: the anchors for this step (as [`set_anchors`](Self::set_anchors)), then the
+    /// step. Every input is validated before anything changes; with `dt == 0` only the anchors are stored.
+    pub fn step_with_anchors<I>(&mut self, anchors: I, dt: f32, camera: Vec3, view_reference: Transform) -> Result<()>
+    where
+        I: ExactSizeIterator<Item = Transform> + Clone,
+    {
+        let k = validate_step(dt, camera, &view_reference)?;
+        self.set_anchors(anchors)?;
+        if dt > 0.0 {
+            self.advance(dt, camera, k);
+        }
+        Ok(())
+    }
+
+    /// The step itself, on validated input (`dt > 0`, K normalised).
+    fn advance(&mut self, dt: f32, camera: Vec3, k: Transform) {
         // Rebase the particle state on the new origin.
         let origin = k.position;
         let shift = self.origin - origin;
@@ -401,7 +412,6 @@ impl Engine {
         self.stats.solver_fallbacks += fallbacks;
         self.stats.time_dropped += dropped;
         self.stats.simulated_time += simulated;
-        Ok(())
     }
 
     // ---- reading ------------------------------------------------------------------------------------
@@ -604,6 +614,16 @@ fn check_chain_capacity(chain: &Chain, capacity: usize) -> Result<()> {
 fn is_teleport(from: &Transform, to: &Transform, settings: &EngineSettings) -> bool {
     (to.position - from.position).length() > settings.teleport_distance
         || rotation_angle(from.rotation.inverse() * to.rotation) > settings.teleport_angle
+}
+
+fn validate_step(dt: f32, camera: Vec3, view_reference: &Transform) -> Result<Transform> {
+    if !(dt.is_finite() && dt >= 0.0) {
+        return Err(Error::invalid_argument(format!("dt must be finite and >= 0, got {dt}")));
+    }
+    if !camera.is_finite() {
+        return Err(Error::invalid_argument("camera position must be finite"));
+    }
+    validate_transform(view_reference).map_err(|e| Error::invalid_argument(format!("view reference: {e}")))
 }
 
 /// A transform from outside, checked and with its rotation normalised: finite, rotation not all zero.

@@ -19,6 +19,7 @@ pub mod params;
 pub mod polar;
 pub mod rod;
 pub mod shape;
+pub mod sketch;
 pub mod weights;
 
 pub use chain::ViewShapeId;

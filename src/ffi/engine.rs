@@ -1,7 +1,7 @@
 //! `kdw_engine`: create, configure, step, read back.
 
 use super::guard::{
-    check_out, check_struct_size, destroy_handle, fill, guard, into_handle, query, read, slice, store_each,
+    check_out, check_struct_size, destroy_handle, fill, guard, into_handle, query, read, slice, slice_mut, store_each,
     with_engine_mut, write,
 };
 use super::status::{KDW_STATUS_OK, kdw_status};
@@ -92,6 +92,51 @@ pub extern "C" fn kdw_engine_step(
         let k = unsafe { read(view_reference, "view_reference") }?;
         // SAFETY: live engine handle, this thread only.
         unsafe { with_engine_mut(engine, |e| Ok(e.step(dt, (*camera).into(), (*k).into())?)) }
+    })
+}
+
+/// A whole frame in one call, for hosts that pay per native call (Unity): sets the anchors (as
+/// `kdw_engine_set_anchors`; `anchor_count` must equal the chain count), steps (as `kdw_engine_step`), and
+/// writes every joint's local rotation (as `kdw_engine_read_local_rotations`; `capacity` must be at least
+/// the joint count). Everything is validated before anything changes; with `dt == 0` only the anchors are
+/// stored.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_step_and_read(
+    engine: *mut kdw_engine,
+    dt: f32,
+    camera_position: *const kdw_vec3,
+    view_reference: *const kdw_transform,
+    anchors: *const kdw_transform,
+    anchor_count: u32,
+    out_local_rotations: *mut kdw_quat,
+    capacity: u32,
+    out_written: *mut u32,
+) -> kdw_status {
+    guard(|| {
+        check_out(out_written, "out_written")?;
+        // SAFETY: the caller passes readable structs.
+        let camera = unsafe { read(camera_position, "camera_position") }?;
+        // SAFETY: as above.
+        let k = unsafe { read(view_reference, "view_reference") }?;
+        // SAFETY: the caller passes `anchor_count` readable transforms.
+        let anchors = unsafe { slice(anchors, anchor_count, "anchors") }?;
+        // SAFETY: the caller passes `capacity` writable quaternions.
+        let out = unsafe { slice_mut(out_local_rotations, capacity, "out_local_rotations") }?;
+        // SAFETY: live engine handle, this thread only.
+        let written = unsafe {
+            with_engine_mut(engine, |e| {
+                if out.len() < e.joint_count() {
+                    let message =
+                        format!("buffer holds {} rotations, the engine has {} joints", out.len(), e.joint_count());
+                    return Err(crate::core::Error::buffer_too_small(message).into());
+                }
+                e.step_with_anchors(anchors.iter().map(|t| Transform::from(*t)), dt, (*camera).into(), (*k).into())?;
+                store_each(out, |capacity, f| e.for_each_local_rotation(capacity, f))
+            })
+        }?;
+        // SAFETY: checked by check_out.
+        unsafe { write(out_written, written as u32) };
+        Ok(())
     })
 }
 

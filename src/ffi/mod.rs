@@ -15,6 +15,7 @@
 pub mod chain;
 pub mod engine;
 pub mod guard;
+pub mod sketch;
 pub mod status;
 pub mod types;
 pub mod version;

@@ -16,6 +16,7 @@
 
 #include "kodawari.h"
 #include "harness.h"
+#include "test_sketch.h"
 
 /* ---- ABI layout: every struct is padding-free and has the size the other language bindings assume ---- */
 
@@ -789,6 +790,59 @@ static int test_view_dependence(void)
 }
 
 /* Chains anchored to their own bones, moved with kdw_engine_set_anchors. */
+/* kdw_engine_step_and_read is set_anchors + step + read_local_rotations in one call: same results bit for
+ * bit, and a rejected frame leaves the engine untouched. */
+static int test_step_and_read(void)
+{
+    kdw_engine *single = engine_new_default();
+    kdw_engine *separate = engine_new_default();
+    ENSURE(single != NULL && separate != NULL);
+    kdw_chain_def own = kdw_chain_def_default();
+    own.anchor = KDW_ANCHOR_OWN;
+    kdw_chain_def follow = kdw_chain_def_default();
+    kdw_chain_id ids[2];
+    for (int e = 0; e < 2; ++e) {
+        kdw_engine *engine = e == 0 ? single : separate;
+        ENSURE_OK(kdw_chain_create(engine, &own, g_side_lock.joints, g_side_lock.n, &ids[0]));
+        ENSURE_OK(kdw_chain_create(engine, &follow, g_ahoge.joints, g_ahoge.n, &ids[1]));
+    }
+    const uint32_t joints = g_side_lock.n + g_ahoge.n;
+    kdw_quat a[MAX_TOTAL], b[MAX_TOTAL];
+    const kdw_transform head = head_at_rest();
+    for (int frame = 0; frame < 90; ++frame) {
+        float t = (float)frame / 60.0f;
+        kdw_transform anchors[2] = {xf(v3(0.2f * sinf(6.0f * t), 1.0f, 0.0f), q_identity()), head};
+        kdw_vec3 camera = v3(3.0f * cosf(t), 1.7f, 3.0f * sinf(t));
+        uint32_t written = 0;
+        ENSURE_OK(kdw_engine_step_and_read(single, 1.0f / 60.0f, &camera, &head, anchors, 2, a, MAX_TOTAL, &written));
+        ENSURE(written == joints);
+        ENSURE_OK(kdw_engine_set_anchors(separate, anchors, 2));
+        ENSURE_OK(kdw_engine_step(separate, 1.0f / 60.0f, &camera, &head));
+        ENSURE_OK(kdw_engine_read_local_rotations(separate, b, MAX_TOTAL, &written));
+        ENSURE(memcmp(a, b, joints * sizeof a[0]) == 0);
+    }
+    ENSURE(hash_of(single) == hash_of(separate));
+
+    /* Rejected frames: nothing changes, not even the anchors. */
+    kdw_transform anchors[2] = {xf(v3(9.0f, 9.0f, 9.0f), q_identity()), head};
+    kdw_vec3 camera = v3(0.0f, 1.7f, 3.0f);
+    uint32_t written = 12345;
+    ENSURE_REJECTED(single, kdw_engine_step_and_read(single, NAN, &camera, &head, anchors, 2, a, MAX_TOTAL, &written),
+                    KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_REJECTED(single, kdw_engine_step_and_read(single, 0.1f, &camera, &head, anchors, 1, a, MAX_TOTAL, &written),
+                    KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_REJECTED(single, kdw_engine_step_and_read(single, 0.1f, &camera, &head, anchors, 2, a, joints - 1, &written),
+                    KDW_STATUS_BUFFER_TOO_SMALL);
+    ENSURE_REJECTED(single, kdw_engine_step_and_read(single, 0.1f, &camera, &head, anchors, 2, NULL, MAX_TOTAL, &written),
+                    KDW_STATUS_NULL_POINTER);
+    ENSURE(written == 12345);
+    ENSURE(hash_of(single) == hash_of(separate));
+
+    ENSURE_OK(engine_free(single));
+    ENSURE_OK(engine_free(separate));
+    return 0;
+}
+
 static int test_own_anchors(void)
 {
     kdw_engine *engine = engine_new_default();
@@ -1710,6 +1764,7 @@ int main(void)
     RUN_TEST(test_life_cycle);
     RUN_TEST(test_view_dependence);
     RUN_TEST(test_own_anchors);
+    RUN_TEST(test_step_and_read);
     RUN_TEST(test_engine_without_chains);
     RUN_TEST(test_substep_clock);
     RUN_TEST(test_determinism_without_view_shapes);
@@ -1728,6 +1783,13 @@ int main(void)
     RUN_TEST(test_error_engine_def);
     RUN_TEST(test_error_buffers);
     RUN_TEST(test_last_error_message);
+    RUN_TEST(test_sketch_layout_and_defaults);
+    RUN_TEST(test_sketch_follows_fitting_strokes);
+    RUN_TEST(test_sketch_round_trip);
+    RUN_TEST(test_sketch_duplicate_points);
+    RUN_TEST(test_sketch_camera_down_the_chain);
+    RUN_TEST(test_sketch_errors);
+    RUN_TEST(test_sketch_result_feeds_a_view_shape);
 
     return HARNESS_SUMMARY();
 }

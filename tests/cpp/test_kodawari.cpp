@@ -179,6 +179,20 @@ void test_life_cycle() {
         CHECK(ahoge.kineticEnergy() >= 0.0f);
         const kodawari::EngineStats stats = engine.stats();
         CHECK(stats.chain_count == 2 && stats.joint_count == 2 * harness::kJoints && stats.substeps_total > 0);
+        // The one-call frame: same rotations as the three calls would give from here on.
+        {
+            std::vector<kodawari::Quat> one_call(local.size());
+            const uint64_t before = engine.stateHash();
+            CHECK(engine.stepAndReadLocalRotations(harness::kDt, harness::orbit_camera(10), scene.head, anchors.data(),
+                                                   2, one_call.data(), static_cast<uint32_t>(one_call.size())) ==
+                  local.size());
+            CHECK(engine.stateHash() != before);
+            CHECK_THROWS(engine.stepAndReadLocalRotations(harness::kDt, harness::orbit_camera(11), scene.head,
+                                                          anchors.data(), 2, one_call.data(), 1),
+                         KDW_STATUS_BUFFER_TOO_SMALL);
+            engine.readLocalRotations(local);
+            CHECK(std::memcmp(local.data(), one_call.data(), local.size() * sizeof(kodawari::Quat)) == 0);
+        }
 
         ahoge.setBaseShape(scene.left);
         ahoge.reset();
@@ -364,6 +378,80 @@ void test_removed_and_destroyed_handles() {
     other.reset();
 }
 
+// The sketch tool: a stroke drawn over a side view becomes a length-keeping shape on that stroke, which
+// then serves as a view shape; a one-point stroke is an error.
+void test_shape_from_stroke() {
+    const kodawari::Vec3 head{0.0f, 1.6f, 0.0f};
+    const Transform head_pose{head, {0.0f, 0.0f, 0.0f, 1.0f}};
+    constexpr uint32_t kCount = 6;
+    std::array<Transform, kCount> current{};  // straight up from the head, world space
+    std::array<Transform, kCount> goal{};     // bending towards +x and the camera (+z)
+    std::array<Transform, kCount> base{};     // `current` in the head's frame
+    for (uint32_t j = 0; j < kCount; ++j) {
+        const float t = static_cast<float>(j);
+        current[j] = Transform{{0.0f, 1.72f + 0.04f * t, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f}};
+        const float angle = 0.25f * t;
+        goal[j] = Transform{{0.04f * t * std::sin(angle), 1.72f + 0.04f * t * std::cos(angle), 0.01f * t},
+                            {0.0f, 0.0f, 0.0f, 1.0f}};
+        base[j] = current[j];
+        base[j].position.y -= head.y;
+    }
+
+    kodawari::StrokeCamera camera;  // 3/4 view from the front right, looking along -z after a yaw
+    const float yaw = 0.5f;
+    camera.rotation = kodawari::Quat{0.0f, std::sin(0.5f * yaw), 0.0f, std::cos(0.5f * yaw)};
+    camera.position = kodawari::Vec3{1.2f * std::sin(yaw), 1.8f, 1.2f * std::cos(yaw)};
+    camera.viewport_width = 640.0f;
+    camera.viewport_height = 480.0f;
+    CHECK(camera.struct_size == sizeof(kdw_stroke_camera));
+
+    std::vector<kodawari::Vec2> stroke;
+    for (const Transform& joint : goal) stroke.push_back(camera.project(joint.position));
+    const kodawari::StrokeShape shape = kodawari::shapeFromStroke(camera, current, head_pose, head_pose, stroke);
+    CHECK(shape.joints.size() == kCount);
+    const auto distance = [](const kodawari::Vec3& a, const kodawari::Vec3& b) {
+        return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z));
+    };
+    CHECK(distance(shape.joints[0].position, base[0].position) < 1e-6f);  // the root stays
+    for (uint32_t j = 0; j + 1 < kCount; ++j) {
+        const float length = distance(shape.joints[j].position, shape.joints[j + 1].position);
+        CHECK(std::fabs(length - 0.04f) < 0.04f * 1e-5f);
+    }
+    const auto off_stroke = [&stroke](const kodawari::Vec2& p) {
+        float best = std::numeric_limits<float>::infinity();
+        for (std::size_t i = 0; i + 1 < stroke.size(); ++i) {
+            const float ax = stroke[i].x, ay = stroke[i].y;
+            const float bx = stroke[i + 1].x - ax, by = stroke[i + 1].y - ay;
+            const float t = std::fmin(1.0f, std::fmax(0.0f, ((p.x - ax) * bx + (p.y - ay) * by) / (bx * bx + by * by)));
+            best = std::fmin(best, std::hypot(p.x - ax - bx * t, p.y - ay - by * t));
+        }
+        return best;
+    };
+    for (uint32_t j = 0; j < kCount; ++j) {  // every joint is seen on the stroke
+        kodawari::Vec3 world = shape.joints[j].position;
+        world.y += head.y;
+        CHECK(off_stroke(camera.project(world)) < 0.5f);
+    }
+
+    // Seen from that camera, the sketched view shape is the rest shape.
+    Engine engine{EngineDef()};
+    const ViewDependentPhysicalObject chain = engine.createChain(ChainDef(), base);
+    const ViewShape sketched = chain.addViewShape(shape, 1.0f);
+    CHECK(sketched.isValid());
+    engine.step(1.0f / 60.0f, camera.position, head_pose);
+    std::vector<Transform> rest;
+    chain.readRestShape(rest);
+    for (uint32_t j = 0; j < kCount; ++j) CHECK(distance(rest[j].position, shape.joints[j].position) < 1e-5f);
+
+    const std::vector<kodawari::Vec2> one_point(1, stroke[0]);
+    CHECK_THROWS(kodawari::shapeFromStroke(camera, current, head_pose, head_pose, one_point),
+                 KDW_STATUS_INVALID_ARGUMENT);
+    kodawari::StrokeCamera behind = camera;
+    behind.position = kodawari::Vec3{0.0f, 1.8f, -1.0f};  // looking away from the chain
+    behind.rotation = kodawari::Quat{0.0f, 0.0f, 0.0f, 1.0f};
+    CHECK_THROWS(behind.project(current[0].position), KDW_STATUS_INVALID_ARGUMENT);
+}
+
 // Runs a test; an unexpected exception fails it.
 #define RUN(test)                                                                          \
     harness::run(#test, [] {                                                               \
@@ -384,6 +472,7 @@ int main() {
     RUN(test_invalid_calls_throw_and_leave_state_unchanged);
     RUN(test_orbit_scene_matches_plain_c);
     RUN(test_removed_and_destroyed_handles);
+    RUN(test_shape_from_stroke);
     run_no_exception_tests();
     std::printf("%d passed, %d failed\n", harness::counters().passed, harness::counters().failed);
     return harness::counters().failed == 0 ? 0 : 1;

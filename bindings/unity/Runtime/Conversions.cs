@@ -1,0 +1,32 @@
+using UnityEngine;
+
+namespace Kodawari.Unity
+{
+    /// <summary>Unity math types to and from the kodawari layout-compatible structs (same memory layout:
+    /// <c>Vector3</c> = <c>Vec3</c>, <c>Vector3</c> + <c>Quaternion</c> = <c>JointTransform</c>).</summary>
+    public static class Conversions
+    {
+        public static Vec3 ToKodawari(this Vector3 v) { return new Vec3(v.x, v.y, v.z); }
+
+        public static Quat ToKodawari(this Quaternion q) { return new Quat(q.x, q.y, q.z, q.w); }
+
+        public static Vector3 ToUnity(this Vec3 v) { return new Vector3(v.X, v.Y, v.Z); }
+
+        public static Quaternion ToUnity(this Quat q) { return new Quaternion(q.X, q.Y, q.Z, q.W); }
+
+        /// <summary>A transform's world pose (position and rotation; scale is not part of a pose).</summary>
+        public static JointTransform WorldPose(this Transform t)
+        {
+            return new JointTransform(t.position.ToKodawari(), t.rotation.ToKodawari());
+        }
+
+        /// <summary><paramref name="t"/>'s pose in the rigid frame of <paramref name="frame"/> (scale ignored, as the
+        /// engine's anchor frames are rigid).</summary>
+        public static JointTransform PoseIn(this Transform t, Transform frame)
+        {
+            Quaternion inverse = Quaternion.Inverse(frame.rotation);
+            Vector3 position = inverse * (t.position - frame.position);
+            return new JointTransform(position.ToKodawari(), (inverse * t.rotation).ToKodawari());
+        }
+    }
+}

@@ -1,0 +1,244 @@
+using System;
+using System.Collections.Generic;
+using UnityEngine;
+
+namespace Kodawari.Unity
+{
+    /// <summary>The kodawari engine of one character. Put it on the character's root: on enable it gathers the
+    /// <see cref="ViewDependentPhysicalObject"/>s below it and creates the native engine; every LateUpdate
+    /// (after animation) it pushes the chains' anchors, runs one native step with the camera and the view
+    /// reference bone, and writes every joint's localRotation. No managed allocation per frame.</summary>
+    [DisallowMultipleComponent]
+    [DefaultExecutionOrder(10000)]
+    [AddComponentMenu("Kodawari/Engine")]
+    public sealed class Engine : MonoBehaviour
+    {
+        [Tooltip("The camera whose view selects the view shapes. Empty: Camera.main.")]
+        public Camera targetCamera;
+
+        [Tooltip("The bone view directions are measured from (usually the head). Empty: this transform.")]
+        public Transform viewReference;
+
+        [Tooltip("Chains to simulate. Empty: every ViewDependentPhysicalObject below this object, gathered on enable.")]
+        public List<ViewDependentPhysicalObject> chains = new List<ViewDependentPhysicalObject>();
+
+        [Header("Solver")]
+        [Tooltip("World gravity, m/s².")]
+        public Vector3 gravity = new Vector3(0f, -9.81f, 0f);
+
+        [Tooltip("Internal fixed steps per simulated second, Hz. Motion does not depend on the frame rate.")]
+        [Range(30f, 1000f)] public float substepRate = 240f;
+
+        [Tooltip("Shape-matching + inextensibility passes per internal step.")]
+        [Range(1, 64)] public int iterations = 2;
+
+        [Tooltip("Simulated seconds per second; 0 pauses.")]
+        [Range(0f, 4f)] public float timeScale = 1f;
+
+        [Tooltip("Most internal steps per frame; time beyond is dropped (a hitch does not explode).")]
+        [Range(1, 1000)] public int maxSubsteps = 16;
+
+        [Header("Teleports")]
+        [Tooltip("An anchor moving farther than this (m) in one frame is carried rigidly instead of whipping the chain.")]
+        public float teleportDistance = 1f;
+
+        [Tooltip("An anchor turning more than this (degrees) in one frame is a teleport.")]
+        [Range(1f, 180f)] public float teleportAngle = 90f;
+
+        [Tooltip("Also reset the chains to their rest shapes when the character root jumps farther than the teleport distance in one frame.")]
+        public bool resetOnTeleport = true;
+
+        Kodawari.Engine native;
+        ViewDependentPhysicalObject[] active = new ViewDependentPhysicalObject[0];
+        Kodawari.ViewDependentPhysicalObject[] chainHandles = new Kodawari.ViewDependentPhysicalObject[0];
+        ViewShape[][] viewShapeHandles = new ViewShape[0][];
+        Transform[] anchorTransforms = new Transform[0];  // one per chain
+        Transform[] jointTransforms = new Transform[0];   // every joint, in the engine's batched order
+        JointTransform[] anchors = new JointTransform[0];
+        Quat[] localRotations = new Quat[0];
+        bool settingsChanged;
+        Vector3 lastRootPosition;
+
+        /// <summary>The native engine while enabled (null otherwise), for advanced use.</summary>
+        public Kodawari.Engine Native { get { return native; } }
+
+        void OnEnable()
+        {
+            try
+            {
+                Build();
+            }
+            catch (Exception e)
+            {
+                Debug.LogException(e, this);
+                Teardown();
+                enabled = false;
+            }
+        }
+
+        void OnDisable() { Teardown(); }
+
+        void OnDestroy() { Teardown(); }
+
+        void OnValidate() { settingsChanged = true; }
+
+        /// <summary>Rebuilds the native engine from the current components (after adding or removing chains).</summary>
+        public void Rebuild()
+        {
+            Teardown();
+            if (isActiveAndEnabled) Build();
+        }
+
+        /// <summary>Puts every chain back to its rest shape, at rest (after a cut, a respawn, a teleport).</summary>
+        public void ResetChains()
+        {
+            if (native != null) native.Reset();
+        }
+
+        EngineDef CreateDef()
+        {
+            return new EngineDef
+            {
+                Gravity = gravity.ToKodawari(),
+                SubstepRate = substepRate,
+                Iterations = iterations,
+                TimeScale = timeScale,
+                MaxSubsteps = maxSubsteps,
+                TeleportDistance = Mathf.Max(teleportDistance, 1e-4f),
+                TeleportAngle = Mathf.Max(teleportAngle, 0.01f) * Mathf.Deg2Rad,
+            };
+        }
+
+        void Build()
+        {
+            var found = new List<ViewDependentPhysicalObject>();
+            if (chains != null && chains.Count > 0)
+            {
+                foreach (var chain in chains)
+                    if (chain != null && chain.isActiveAndEnabled) found.Add(chain);
+            }
+            else
+            {
+                found.AddRange(GetComponentsInChildren<ViewDependentPhysicalObject>(false));
+            }
+
+            native = new Kodawari.Engine(CreateDef());
+            var jointList = new List<Transform>();
+            var anchorList = new List<Transform>();
+            var activeList = new List<ViewDependentPhysicalObject>();
+            var handleList = new List<Kodawari.ViewDependentPhysicalObject>();
+            var viewHandleList = new List<ViewShape[]>();
+            Transform reference = ViewReference;
+            foreach (var chain in found)
+            {
+                List<Transform> joints = chain.CollectJoints();
+                Transform anchor = chain.Anchor;
+                if (joints.Count < 2 || anchor == null)
+                {
+                    Debug.LogWarning("Kodawari: " + chain.name + " needs a parent (its anchor) and at least 2 joints; skipped.", chain);
+                    continue;
+                }
+                var shape = new JointTransform[joints.Count];
+                for (int i = 0; i < joints.Count; i++) shape[i] = joints[i].PoseIn(anchor);
+                Kodawari.ViewDependentPhysicalObject handle = native.CreateChain(chain.CreateDef(), shape);
+                var viewHandles = new ViewShape[chain.viewShapes.Count];
+                for (int v = 0; v < chain.viewShapes.Count; v++)
+                {
+                    ViewShapeData view = chain.viewShapes[v];
+                    if (view.positions.Length != joints.Count || view.rotations.Length != joints.Count)
+                    {
+                        Debug.LogWarning("Kodawari: a view shape of " + chain.name + " was captured with another joint count; recapture it.", chain);
+                        continue;
+                    }
+                    var viewJoints = new JointTransform[joints.Count];
+                    for (int i = 0; i < joints.Count; i++)
+                        viewJoints[i] = new JointTransform(view.positions[i].ToKodawari(), view.rotations[i].ToKodawari());
+                    viewHandles[v] = handle.AddViewShape(view.direction.ToKodawari(), viewJoints, Mathf.Max(view.influence, 1e-3f));
+                }
+                handleList.Add(handle);
+                viewHandleList.Add(viewHandles);
+                chain.parametersChanged = false;
+                activeList.Add(chain);
+                anchorList.Add(anchor);
+                jointList.AddRange(joints);
+            }
+            active = activeList.ToArray();
+            chainHandles = handleList.ToArray();
+            viewShapeHandles = viewHandleList.ToArray();
+            anchorTransforms = anchorList.ToArray();
+            jointTransforms = jointList.ToArray();
+            anchors = new JointTransform[anchorTransforms.Length];
+            localRotations = new Quat[jointTransforms.Length];
+            settingsChanged = false;
+            lastRootPosition = transform.position;
+            if (reference == null) Debug.LogWarning("Kodawari: no view reference bone", this);
+        }
+
+        void Teardown()
+        {
+            if (native != null) native.Dispose();
+            native = null;
+        }
+
+        bool AnyChainChanged()
+        {
+            for (int i = 0; i < active.Length; i++)
+                if (active[i].parametersChanged) return true;
+            return false;
+        }
+
+        Transform ViewReference { get { return viewReference != null ? viewReference : transform; } }
+
+        void LateUpdate()
+        {
+            if (native == null) return;
+            if (settingsChanged || AnyChainChanged()) ApplySettings();
+
+            // Anchors: each chain root's parent.
+            for (int i = 0; i < anchorTransforms.Length; i++) anchors[i] = anchorTransforms[i].WorldPose();
+
+            if (resetOnTeleport && (transform.position - lastRootPosition).sqrMagnitude > teleportDistance * teleportDistance)
+                native.Reset();
+            lastRootPosition = transform.position;
+
+            Camera view = targetCamera != null ? targetCamera : Camera.main;
+            Transform reference = ViewReference;
+            Vec3 cameraPosition = view != null ? view.transform.position.ToKodawari() : reference.position.ToKodawari();
+            // One native call per frame: anchors in, step, local rotations out.
+            native.StepAndReadLocalRotations(Time.deltaTime, cameraPosition, reference.WorldPose(), anchors, localRotations);
+            for (int i = 0; i < jointTransforms.Length; i++) jointTransforms[i].localRotation = localRotations[i].ToUnity();
+        }
+
+        void ApplySettings()
+        {
+            if (settingsChanged)
+            {
+                settingsChanged = false;
+                native.Def = CreateDef();
+            }
+            // Per-chain edits (inspector sliders, MarkSettingsChanged): parameters and view shape influences.
+            for (int i = 0; i < active.Length; i++)
+            {
+                ViewDependentPhysicalObject chain = active[i];
+                if (!chain.parametersChanged) continue;
+                chain.parametersChanged = false;
+                chainHandles[i].Def = chain.CreateDef();
+                ViewShape[] views = viewShapeHandles[i];
+                for (int v = 0; v < views.Length && v < chain.viewShapes.Count; v++)
+                {
+                    if (views[v].Engine == null) continue; // skipped at build (joint count mismatch)
+                    views[v].SetInfluence(Mathf.Max(chain.viewShapes[v].influence, 1e-3f));
+                    if (chain.viewShapes[v].direction.sqrMagnitude > 0f) views[v].SetDirection(chain.viewShapes[v].direction.ToKodawari());
+                }
+            }
+        }
+
+        /// <summary>Marks settings and chain parameters for upload at the next LateUpdate (after changing fields
+        /// from a script at run time).</summary>
+        public void MarkSettingsChanged()
+        {
+            settingsChanged = true;
+            foreach (var chain in active) chain.parametersChanged = true;
+        }
+    }
+}

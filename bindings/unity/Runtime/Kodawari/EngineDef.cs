@@ -1,0 +1,81 @@
+// Copied from bindings/csharp/Kodawari/EngineDef.cs by `cargo gen-bindings`. Edit the original: a test fails when this copy is stale.
+using Kodawari.Native;
+
+namespace Kodawari
+{
+    /// <summary>Engine settings. A new instance holds the library's defaults (<c>kdw_engine_def_default()</c>),
+    /// so a default can never be forgotten: <c>new EngineDef { SubstepRate = 120f }</c>.</summary>
+    public sealed class EngineDef
+    {
+        internal kdw_engine_def Raw;
+
+        public EngineDef()
+        {
+            Library.EnsureCompatible();
+            Raw = NativeMethods.kdw_engine_def_default();
+        }
+
+        internal EngineDef(kdw_engine_def raw) { Raw = raw; }
+
+        /// <summary>World gravity, m/s². Default (0, -9.81, 0).</summary>
+        public Vec3 Gravity
+        {
+            get { return new Vec3(Raw.gravity.x, Raw.gravity.y, Raw.gravity.z); }
+            set { Raw.gravity.x = value.X; Raw.gravity.y = value.Y; Raw.gravity.z = value.Z; }
+        }
+
+        /// <summary>Internal fixed steps per simulated second, Hz, in [30, 10000]. Default 240.</summary>
+        public float SubstepRate { get { return Raw.substep_rate; } set { Raw.substep_rate = value; } }
+
+        /// <summary>Most internal steps per step call, in [1, 1000]; time beyond is dropped and counted. Default 16.</summary>
+        public int MaxSubsteps { get { return (int)Raw.max_substeps; } set { Raw.max_substeps = (uint)value; } }
+
+        /// <summary>Shape-matching + inextensibility passes per internal step, in [1, 64]. Default 2.</summary>
+        public int Iterations { get { return (int)Raw.iterations; } set { Raw.iterations = (uint)value; } }
+
+        /// <summary>Simulated seconds per second of dt, in [0, 100]; 0 pauses. Default 1.</summary>
+        public float TimeScale { get { return Raw.time_scale; } set { Raw.time_scale = value; } }
+
+        /// <summary>An anchor moving farther than this (m) in one step is a teleport. Default 1.</summary>
+        public float TeleportDistance { get { return Raw.teleport_distance; } set { Raw.teleport_distance = value; } }
+
+        /// <summary>An anchor turning more than this (radians) in one step is a teleport. Default pi/2.</summary>
+        public float TeleportAngle { get { return Raw.teleport_angle; } set { Raw.teleport_angle = value; } }
+    }
+
+    /// <summary>Chain parameters. A new instance holds the library's defaults (<c>kdw_chain_def_default()</c>).</summary>
+    public sealed class ChainDef
+    {
+        internal kdw_chain_def Raw;
+
+        public ChainDef()
+        {
+            Library.EnsureCompatible();
+            Raw = NativeMethods.kdw_chain_def_default();
+        }
+
+        internal ChainDef(kdw_chain_def raw) { Raw = raw; }
+
+        /// <summary>Pull towards the rest shape in [0, 1]: 0 limp, 1 rigid. Default 0.5.</summary>
+        public float Stiffness { get { return Raw.stiffness; } set { Raw.stiffness = value; } }
+
+        /// <summary>Velocity damping per second, 1/s, in [0, 1000]. Default 1.</summary>
+        public float Damping { get { return Raw.damping; } set { Raw.damping = value; } }
+
+        /// <summary>Share of the motion caused by a changing rest shape that is not turned into velocity, [0, 1].
+        /// Default 1.</summary>
+        public float MomentumSuppression { get { return Raw.momentum_suppression; } set { Raw.momentum_suppression = value; } }
+
+        /// <summary>Mass per particle, kg, &gt; 0. Default 1.</summary>
+        public float Mass { get { return Raw.mass; } set { Raw.mass = value; } }
+
+        /// <summary>Particle radius, m, &gt;= 0. Default 0.02.</summary>
+        public float Radius { get { return Raw.radius; } set { Raw.radius = value; } }
+
+        /// <summary>Multiplier on the engine's gravity, in [-100, 100]. Default 1.</summary>
+        public float GravityScale { get { return Raw.gravity_scale; } set { Raw.gravity_scale = value; } }
+
+        /// <summary>Where the chain's anchor comes from. Default <see cref="AnchorSource.ViewReference"/>.</summary>
+        public AnchorSource Anchor { get { return (AnchorSource)Raw.anchor; } set { Raw.anchor = (uint)value; } }
+    }
+}

@@ -85,7 +85,7 @@ fn csharp_tests_pass_under_mono() {
     assert!(output.status.success() && last.ends_with(" passed, 0 failed"), "C# tests failed: {last}");
 }
 
-/// bindings/csharp/README.md shows exactly the snippet that tests/csharp/ReadmeSnippet.cs compiles and runs.
+/// README.md and bindings/csharp/README.md show exactly the snippet that tests/csharp/ReadmeSnippet.cs compiles and runs.
 #[test]
 fn readme_snippet_is_the_tested_one() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -95,9 +95,11 @@ fn readme_snippet_is_the_tested_one() {
     let end = source[begin..].find("        // --- README snippet end ---").expect("end marker") + begin;
     let snippet: String =
         source[begin..end].lines().map(|l| format!("{}\n", l.strip_prefix("        ").unwrap_or(l))).collect();
-    let readme = std::fs::read_to_string(root.join("bindings/csharp/README.md")).expect("read README");
-    assert!(
-        readme.contains(&format!("```csharp\n{snippet}```")),
-        "bindings/csharp/README.md must show tests/csharp/ReadmeSnippet.cs's snippet verbatim:\n{snippet}"
-    );
+    for readme in ["README.md", "bindings/csharp/README.md"] {
+        let text = std::fs::read_to_string(root.join(readme)).expect("read README");
+        assert!(
+            text.contains(&format!("```csharp\n{snippet}```")),
+            "{readme} must show tests/csharp/ReadmeSnippet.cs's snippet verbatim:\n{snippet}"
+        );
+    }
 }

@@ -48,7 +48,8 @@ typedef struct kdw_chain_def {
     // Pull towards the rest shape in [0, 1]: 0 limp (an n-pendulum), 1 rigid. Independent of substep
     // rate and iterations. Default 0.5.
     float stiffness;
-    // Velocity damping per second, 1/s, in [0, 1000]. Default 1.
+    // Velocity damping per second, 1/s, in [0, 1000], acting on velocity relative to the chain's root.
+    // Default 1.
     float damping;
     // Share of the motion caused by a changing rest shape that is not turned into velocity, [0, 1].
     // Default 1.

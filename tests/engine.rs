@@ -250,3 +250,27 @@ fn stiffness_is_independent_of_solver_settings() {
         }
     }
 }
+
+/// Galilean invariance: a root carried at constant velocity settles into the same shape (relative to the
+/// root) as a still one. Damping acts on velocity relative to the root, not on world velocity (air drag).
+#[test]
+fn constant_velocity_root_settles_like_a_still_one() {
+    let base = curled_chain(8, Vec3::ZERO, Vec3::new(1.0, -0.3, 0.0), Vec3::Z, 0.15, 0.05);
+    let length = chain_length(&base);
+    let settle = |velocity: Vec3| -> Vec<Vec3> {
+        let mut engine = engine_with(EngineSettings::default());
+        let id =
+            engine.create_chain(ChainParams { stiffness: 0.0, damping: 2.0, ..Default::default() }, &base).unwrap();
+        let mut root = HEAD;
+        for _ in 0..(60 * 12) {
+            root += velocity / 60.0;
+            engine.step(1.0 / 60.0, root + Vec3::new(0.0, 0.0, 3.0), at(root)).unwrap();
+        }
+        chain_world(&engine, id).iter().map(|t| t.position - root).collect()
+    };
+    let still = settle(Vec3::ZERO);
+    let moving = settle(Vec3::new(3.0, 0.0, 0.0));
+    let difference = still.iter().zip(&moving).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max) / length;
+    println!("Galilean invariance: settled shape with the root at 3 m/s differs by {difference:.2e} chain lengths");
+    assert!(difference < 1e-3, "{difference}");
+}

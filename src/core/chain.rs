@@ -203,17 +203,27 @@ impl Chain {
     }
 
     /// Output pose at fraction `t` between the last two internal states, with every joint's bone axis
-    /// swung onto the next joint (skinning-ready) and its twist kept.
+    /// swung onto the next joint (skinning-ready) and its twist kept. The pose is rebuilt from the root along
+    /// the interpolated segment directions with the exact segment lengths: interpolating positions directly
+    /// would shorten a fast-turning bone (by up to 2% at render rates that do not divide the substep rate).
     pub(crate) fn write_output(&mut self, t: f32) {
         let n = self.joint_count();
         for j in 0..n {
             let (a, b) = (&self.local_previous[j], &self.local_current[j]);
-            self.output[j] = Transform::new(a.position.lerp(b.position, t), nlerp_shorter(a.rotation, b.rotation, t));
+            self.output[j].rotation = nlerp_shorter(a.rotation, b.rotation, t);
         }
+        self.output[0].position = self.local_previous[0].position.lerp(self.local_current[0].position, t);
         for j in 0..n - 1 {
-            if let Some(dir) = direction(self.output[j + 1].position - self.output[j].position) {
-                self.output[j].rotation = swing_to(self.output[j].rotation, self.bone_axes[j], dir);
-            }
+            let before = self.local_previous[j + 1].position - self.local_previous[j].position;
+            let after = self.local_current[j + 1].position - self.local_current[j].position;
+            let blended = match (direction(before), direction(after)) {
+                (Some(a), Some(b)) => direction(a.lerp(b, t)).unwrap_or(b),
+                (_, Some(b)) => b,
+                (Some(a), None) => a,
+                (None, None) => self.bone_axes[j],
+            };
+            self.output[j + 1].position = self.output[j].position + blended * self.frame.lengths[j];
+            self.output[j].rotation = swing_to(self.output[j].rotation, self.bone_axes[j], blended);
         }
     }
 

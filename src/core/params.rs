@@ -82,7 +82,8 @@ pub struct ChainParams {
     /// In between the rest shape acts like a spring of angular frequency `STIFFNESS_FREQUENCY * s / (1 - s)`
     /// rad/s, independent of substep rate and iterations.
     pub stiffness: f32,
-    /// Velocity damping per second, 1/s (velocity decays by `exp(-damping * t)`). Range [0, 1000].
+    /// Velocity damping per second, 1/s: velocity relative to the chain's root decays by `exp(-damping * t)`
+    /// (relative, so motion does not depend on how fast the whole character travels). Range [0, 1000].
     pub damping: f32,
     /// Share of the motion caused by a changing rest shape that is not turned into velocity, [0, 1].
     pub momentum_suppression: f32,

@@ -132,10 +132,13 @@ pub fn substep(state: &mut RodState, lengths: &[f32], input: &SubstepInput<'_>, 
     p[0] = input.anchor.place_f64(input.rest.positions[0]);
     qp[0] = (input.anchor.rotation * input.rest.orientations[0]).normalize();
 
-    // Predict the dynamic particles.
+    // Predict the dynamic particles. Damping acts on velocity relative to the root, so a character moving
+    // at constant velocity (a train, an elevator) swings exactly like one standing still.
     let kick = if input.half_kick { 0.5 * h } else { h };
+    let root_velocity = ((p[0] - state.x[0]) / h as f64).as_vec3();
     for i in 1..n {
-        state.v[i] = state.v[i] * input.velocity_decay + input.gravity * kick;
+        let relative = state.v[i] - root_velocity;
+        state.v[i] = root_velocity + relative * input.velocity_decay + input.gravity * kick;
         state.w[i] *= input.velocity_decay;
         p[i] = state.x[i] + (state.v[i] * h).as_dvec3();
         qp[i] = (Quat::from_scaled_axis(state.w[i] * h) * state.q[i]).normalize();

@@ -494,7 +494,8 @@ namespace Kodawari.Native
         /// </summary>
         public float stiffness;
         /// <summary>
-        ///  Velocity damping per second, 1/s, in [0, 1000]. Default 1.
+        ///  Velocity damping per second, 1/s, in [0, 1000], acting on velocity relative to the chain's root.
+        ///  Default 1.
         /// </summary>
         public float damping;
         /// <summary>

@@ -448,6 +448,15 @@ kdw_status kdw_view_shape_is_valid(const struct kdw_engine *engine,
                                    kdw_view_shape_id view_shape,
                                    uint32_t *out_valid);
 
+// The weights of the chain's last blend (updated by every step): `out_weights[0]` is the base shape's,
+// then one per view shape in the order they were added. They are >= 0 and sum to 1. `capacity` must be at
+// least `1 + view shape count`.
+kdw_status kdw_chain_read_weights(const struct kdw_engine *engine,
+                                  kdw_chain_id chain,
+                                  float *out_weights,
+                                  uint32_t capacity,
+                                  uint32_t *out_written);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

@@ -274,3 +274,25 @@ fn constant_velocity_root_settles_like_a_still_one() {
     println!("Galilean invariance: settled shape with the root at 3 m/s differs by {difference:.2e} chain lengths");
     assert!(difference < 1e-3, "{difference}");
 }
+
+/// The weights of the last blend are readable (for gizmos): base first, then view shapes in order; they
+/// follow the camera and sum to 1.
+#[test]
+fn blend_weights_are_readable() {
+    let (mut engine, id) = scene();
+    let bent = curled_chain(6, Vec3::new(0.0, 0.1, 0.0), Vec3::Y, Vec3::X, 0.3, 0.04);
+    engine.add_view_shape(id, -Vec3::Z, &bent, 2.0).unwrap();
+    let read = |engine: &kodawari::Engine| {
+        let mut weights = Vec::new();
+        engine.for_each_chain_weight(id, 3, |w| weights.push(w)).unwrap();
+        weights
+    };
+    // The camera on the view shape's side (+z): the first view shape takes everything.
+    engine.step(1.0 / 60.0, HEAD + Vec3::new(0.0, 0.0, 3.0), at(HEAD)).unwrap();
+    assert_eq!(read(&engine), vec![0.0, 1.0, 0.0]);
+    // From +x both view shapes see the camera at 90 degrees: (1/2)^1 and (1/2)^2, the base the rest.
+    engine.step(1.0 / 60.0, HEAD + Vec3::new(3.0, 0.0, 0.0), at(HEAD)).unwrap();
+    let w = read(&engine);
+    assert!((w[1] - 0.5).abs() < 1e-6 && (w[2] - 0.25).abs() < 1e-6 && (w[0] - 0.25).abs() < 1e-6, "{w:?}");
+    assert_eq!(engine.for_each_chain_weight(id, 2, |_| {}).unwrap_err().kind, ErrorKind::BufferTooSmall);
+}

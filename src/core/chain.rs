@@ -36,6 +36,8 @@ pub struct Chain {
     bone_axes: Vec<Vec3>,
     pub(crate) views: Vec<ViewShape>,
     weights: Vec<f32>,
+    /// The base shape's weight in the last blend.
+    base_weight: f32,
     blended: EncodedShape,
     /// The rest shape the solver pulls towards (anchor frame).
     pub(crate) rest: Shape,
@@ -74,6 +76,7 @@ impl Chain {
             base,
             views: Vec::new(),
             weights: Vec::new(),
+            base_weight: 1.0,
             blended: EncodedShape::identity(n),
             rest: base_shape.clone(),
             rest_used: base_shape.clone(),
@@ -152,11 +155,14 @@ impl Chain {
         self.blended_for = view;
         if self.views.is_empty() || view.is_none() {
             self.blended.clone_from(&self.base);
+            self.weights.clear();
+            self.base_weight = 1.0;
         } else {
             let d = view.unwrap_or(Vec3::Z);
             self.weights.resize(self.views.len(), 0.0);
             let weightings = self.views.iter().map(|v| v.weighting);
             let w0 = blend_weights(d, weightings, &mut self.weights);
+            self.base_weight = w0;
             let views = self.views.iter().zip(self.weights.iter()).map(|(v, w)| (&v.encoded, *w));
             blend_into(&self.base, w0, views, &mut self.blended);
         }
@@ -225,6 +231,13 @@ impl Chain {
             self.output[j + 1].position = self.output[j].position + blended * self.frame.lengths[j];
             self.output[j].rotation = swing_to(self.output[j].rotation, self.bone_axes[j], blended);
         }
+    }
+
+    /// Weights of the last blend: the base shape's, then each view shape's in the order they were added
+    /// (0 for shapes added since). Updated by every step.
+    pub(crate) fn weights(&self) -> impl Iterator<Item = f32> + '_ {
+        let views = (0..self.views.len()).map(|i| self.weights.get(i).copied().unwrap_or(0.0));
+        std::iter::once(self.base_weight).chain(views)
     }
 
     pub(crate) fn view_shape_index(&self, id: ViewShapeId) -> Option<usize> {

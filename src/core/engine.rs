@@ -520,6 +520,21 @@ impl Engine {
         Ok(i)
     }
 
+    /// Calls `f` with the weights of the chain's last blend: the base shape's first, then each view shape's in
+    /// the order they were added (what a gizmo shows). Fails without calling it when `capacity` is below
+    /// `1 + view_shape_count`.
+    pub fn for_each_chain_weight(&self, id: ChainId, capacity: usize, f: impl FnMut(f32)) -> Result<()> {
+        let chain = self.chain(id)?;
+        if capacity < 1 + chain.views.len() {
+            return Err(Error::buffer_too_small(format!(
+                "buffer holds {capacity} weights, the chain needs {} (base + view shapes)",
+                1 + chain.views.len()
+            )));
+        }
+        chain.weights().for_each(f);
+        Ok(())
+    }
+
     /// Kinetic energy of a chain's dynamic particles (J), from internal velocities.
     pub fn chain_kinetic_energy(&self, id: ChainId) -> Result<f32> {
         let chain = self.chain(id)?;

@@ -2,7 +2,7 @@
 
 use super::chain::joints_from;
 use super::engine::kdw_engine;
-use super::guard::{check_out, guard, query, read, slice, with_engine_mut, write};
+use super::guard::{check_out, fill, guard, query, read, slice, store_each, with_engine_mut, write};
 use super::status::kdw_status;
 use super::types::{kdw_chain_id, kdw_transform, kdw_vec3, kdw_view_shape_id};
 use crate::core::{ChainId, ViewShapeId};
@@ -115,4 +115,20 @@ pub extern "C" fn kdw_view_shape_is_valid(
     out_valid: *mut u32,
 ) -> kdw_status {
     query(engine, out_valid, "out_valid", |e| Ok(e.is_view_shape_valid(ViewShapeId::from_bits(view_shape)) as u32))
+}
+
+/// The weights of the chain's last blend (updated by every step): `out_weights[0]` is the base shape's,
+/// then one per view shape in the order they were added. They are >= 0 and sum to 1. `capacity` must be at
+/// least `1 + view shape count`.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_chain_read_weights(
+    engine: *const kdw_engine,
+    chain: kdw_chain_id,
+    out_weights: *mut f32,
+    capacity: u32,
+    out_written: *mut u32,
+) -> kdw_status {
+    fill(engine, out_weights, capacity, out_written, "out_weights", |e, out| {
+        store_each(out, |capacity, f| e.for_each_chain_weight(ChainId::from_bits(chain), capacity, f))
+    })
 }

@@ -687,6 +687,15 @@ static int test_life_cycle(void)
     uint32_t shape_valid = 0;
     ENSURE_OK(kdw_view_shape_is_valid(engine, s.right, &shape_valid));
     ENSURE(shape_valid == 1);
+    /* The last blend's weights: base + two view shapes, non-negative, summing to 1. */
+    float weights[3] = {-1.0f, -1.0f, -1.0f};
+    uint32_t weight_count = 0;
+    ENSURE_REJECTED(engine, kdw_chain_read_weights(engine, s.chains[0], weights, 2, &weight_count),
+                    KDW_STATUS_BUFFER_TOO_SMALL);
+    ENSURE(weights[0] == -1.0f && weight_count == 0);
+    ENSURE_OK(kdw_chain_read_weights(engine, s.chains[0], weights, 3, &weight_count));
+    ENSURE(weight_count == 3 && weights[0] >= 0.0f && weights[1] >= 0.0f && weights[2] >= 0.0f);
+    ENSURE_SMALL(weights[0] + weights[1] + weights[2] - 1.0f, 1e-6f);
     uint64_t before = hash_of(engine);
     ENSURE_OK(kdw_view_shape_remove(engine, s.right));
     ENSURE_OK(kdw_view_shape_is_valid(engine, s.right, &shape_valid));

@@ -331,6 +331,14 @@ namespace Kodawari.Native
         [DllImport(__DllName, EntryPoint = "kdw_view_shape_is_valid", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
         internal static extern int kdw_view_shape_is_valid(kdw_engine* engine, ulong view_shape, uint* out_valid);
 
+        /// <summary>
+        ///  The weights of the chain's last blend (updated by every step): `out_weights[0]` is the base shape's,
+        ///  then one per view shape in the order they were added. They are &gt;= 0 and sum to 1. `capacity` must be at
+        ///  least `1 + view shape count`.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_chain_read_weights", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_chain_read_weights(kdw_engine* engine, ulong chain, float* out_weights, uint capacity, uint* out_written);
+
 
     }
 

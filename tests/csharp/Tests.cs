@@ -24,6 +24,12 @@ static unsafe class Tests
         Run("own_anchors_and_local_rotations", OwnAnchorsAndLocalRotations);
         Run("zero_managed_allocation_per_frame", ZeroManagedAllocationPerFrame);
         Run("per_call_overhead_vs_direct", PerCallOverhead);
+        Run("stroke_camera_defaults_and_projection", SketchTests.CameraDefaultsAndProjection);
+        Run("shape_from_stroke_follows_reachable_stroke", SketchTests.ShapeFromStrokeFollowsReachableStroke);
+        Run("shape_from_stroke_round_trip", SketchTests.ShapeFromStrokeRoundTrip);
+        Run("shape_from_stroke_errors", SketchTests.ShapeFromStrokeErrors);
+        Run("sketched_view_shape_drives_the_chain", SketchTests.SketchedViewShapeDrivesTheChain);
+        Run("weights_follow_the_camera", SketchTests.WeightsFollowTheCamera);
         Run("readme_snippet", ReadmeSnippet.Run);
         Console.WriteLine(passed + " passed, " + failed + " failed");
         return failed;

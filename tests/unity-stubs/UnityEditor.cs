@@ -1,5 +1,6 @@
 // Compile-only stand-in for the part of the UnityEditor API the kodawari Unity package's editor scripts use:
 // real namespaces, type names and signatures (Unity scripting reference), no behaviour.
+#pragma warning disable 0067
 using System;
 using UnityEngine;
 using Object = UnityEngine.Object;
@@ -13,6 +14,7 @@ namespace UnityEditor
         public SerializedObject serializedObject { get { throw null; } }
         public virtual void OnInspectorGUI() { }
         public bool DrawDefaultInspector() { throw null; }
+        public void Repaint() { }
     }
 
     public class SerializedObject
@@ -50,6 +52,40 @@ namespace UnityEditor
     {
         public static SceneView lastActiveSceneView { get { throw null; } }
         public Camera camera { get { throw null; } }
+        public static event Action<SceneView> duringSceneGui;
+        public static void RepaintAll() { }
+    }
+
+    public sealed class HandleUtility
+    {
+        public static void AddDefaultControl(int controlId) { }
+        public static Vector2 GUIPointToScreenPixelCoordinate(Vector2 guiPoint) { throw null; }
+        public static Ray GUIPointToWorldRay(Vector2 position) { throw null; }
+    }
+
+    public sealed class Handles
+    {
+        public static Color color { get { throw null; } set { } }
+        public static void DrawAAPolyLine(float width, params Vector3[] points) { }
+        public static void Label(Vector3 position, string text) { }
+    }
+
+    [Flags]
+    public enum GizmoType
+    {
+        Pickable = 1,
+        NotInSelectionHierarchy = 2,
+        Selected = 4,
+        Active = 8,
+        InSelectionHierarchy = 16,
+        NonSelected = 32,
+    }
+
+    [AttributeUsage(AttributeTargets.Method)]
+    public sealed class DrawGizmo : Attribute
+    {
+        public DrawGizmo(GizmoType gizmo) { }
+        public DrawGizmo(GizmoType gizmo, Type drawnGizmoType) { }
     }
 
     public class Selection
@@ -105,6 +141,7 @@ namespace UnityEditor
         public static void LabelField(string label, params GUILayoutOption[] options) { }
         public static void LabelField(string label, GUIStyle style, params GUILayoutOption[] options) { }
         public static void HelpBox(string message, MessageType type) { }
+        public static bool Toggle(string label, bool value, params GUILayoutOption[] options) { throw null; }
         public static void Space() { }
         public static void BeginHorizontal(params GUILayoutOption[] options) { }
         public static void EndHorizontal() { }

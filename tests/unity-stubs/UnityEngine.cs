@@ -66,6 +66,96 @@ namespace UnityEngine
     {
         public static Camera main { get { throw null; } }
         public static Camera current { get { throw null; } }
+        public float fieldOfView { get { throw null; } set { } }
+        public bool orthographic { get { throw null; } set { } }
+        public float orthographicSize { get { throw null; } set { } }
+        public float nearClipPlane { get { throw null; } set { } }
+        public int pixelWidth { get { throw null; } }
+        public int pixelHeight { get { throw null; } }
+    }
+
+    public struct Ray
+    {
+        public Ray(Vector3 origin, Vector3 direction) { throw null; }
+        public Vector3 origin { get { throw null; } set { } }
+        public Vector3 direction { get { throw null; } set { } }
+        public Vector3 GetPoint(float distance) { throw null; }
+    }
+
+    public struct Vector2 : IEquatable<Vector2>
+    {
+        public float x;
+        public float y;
+        public Vector2(float x, float y) { this.x = x; this.y = y; }
+        public float magnitude { get { throw null; } }
+        public float sqrMagnitude { get { throw null; } }
+        public static Vector2 operator +(Vector2 a, Vector2 b) { throw null; }
+        public static Vector2 operator -(Vector2 a, Vector2 b) { throw null; }
+        public static bool operator ==(Vector2 lhs, Vector2 rhs) { throw null; }
+        public static bool operator !=(Vector2 lhs, Vector2 rhs) { throw null; }
+        public bool Equals(Vector2 other) { throw null; }
+        public override bool Equals(object other) { throw null; }
+        public override int GetHashCode() { throw null; }
+        public override string ToString() { throw null; }
+    }
+
+    public struct Color : IEquatable<Color>
+    {
+        public float r;
+        public float g;
+        public float b;
+        public float a;
+        public Color(float r, float g, float b, float a) { this.r = r; this.g = g; this.b = b; this.a = a; }
+        public Color(float r, float g, float b) { this.r = r; this.g = g; this.b = b; this.a = 1f; }
+        public static Color white { get { throw null; } }
+        public bool Equals(Color other) { throw null; }
+        public override bool Equals(object other) { throw null; }
+        public override int GetHashCode() { throw null; }
+    }
+
+    public sealed class Gizmos
+    {
+        public static Color color { get { throw null; } set { } }
+        public static void DrawLine(Vector3 from, Vector3 to) { }
+        public static void DrawWireSphere(Vector3 center, float radius) { }
+        public static void DrawSphere(Vector3 center, float radius) { }
+    }
+
+    public enum EventType
+    {
+        MouseDown = 0,
+        MouseUp = 1,
+        MouseMove = 2,
+        MouseDrag = 3,
+        KeyDown = 4,
+        KeyUp = 5,
+        ScrollWheel = 6,
+        Repaint = 7,
+        Layout = 8,
+        Used = 12,
+    }
+
+    public enum FocusType
+    {
+        Keyboard = 1,
+        Passive = 2,
+    }
+
+    public sealed class Event
+    {
+        public static Event current { get { throw null; } set { } }
+        public EventType type { get { throw null; } set { } }
+        public int button { get { throw null; } set { } }
+        public bool alt { get { throw null; } }
+        public Vector2 mousePosition { get { throw null; } set { } }
+        public EventType GetTypeForControl(int controlID) { throw null; }
+        public void Use() { }
+    }
+
+    public class GUIUtility
+    {
+        public static int hotControl { get { throw null; } set { } }
+        public static int GetControlID(FocusType focus) { throw null; }
     }
 
     public struct Vector3 : IEquatable<Vector3>
@@ -78,6 +168,8 @@ namespace UnityEngine
         public static Vector3 one { get { throw null; } }
         public static Vector3 up { get { throw null; } }
         public static Vector3 forward { get { throw null; } }
+        public static Vector3 right { get { throw null; } }
+        public static Vector3 Cross(Vector3 lhs, Vector3 rhs) { throw null; }
         public Vector3 normalized { get { throw null; } }
         public float magnitude { get { throw null; } }
         public float sqrMagnitude { get { throw null; } }
@@ -126,6 +218,8 @@ namespace UnityEngine
         public static float Min(float a, float b) { throw null; }
         public static float Clamp(float value, float min, float max) { throw null; }
         public static float Clamp01(float value) { throw null; }
+        public static float Abs(float f) { throw null; }
+        public static float Pow(float f, float p) { throw null; }
     }
 
     public class Time

@@ -49,6 +49,8 @@ namespace Kodawari
             CheckSize("Vec3", sizeof(Vec3), Marshal.SizeOf(typeof(Vec3)), 12);
             CheckSize("Quat", sizeof(Quat), Marshal.SizeOf(typeof(Quat)), 16);
             CheckSize("JointTransform", sizeof(JointTransform), Marshal.SizeOf(typeof(JointTransform)), 28);
+            CheckSize("Vec2", sizeof(Vec2), Marshal.SizeOf(typeof(Vec2)), 8);
+            CheckSize("kdw_stroke_camera", sizeof(kdw_stroke_camera), Marshal.SizeOf(typeof(kdw_stroke_camera)), 56);
         }
 
         internal static void CheckSize(string name, int unmanaged, int marshalled, int expected)

@@ -139,6 +139,19 @@ namespace Kodawari
             }
         }
 
+        /// <summary>The weights of the chain's last blend (updated by every step): <c>output[0]</c> is the base
+        /// shape's, then one per view shape in the order they were added. They are &gt;= 0 and sum to 1.
+        /// <paramref name="output"/> needs at least <c>1 + </c><see cref="ViewShapeCount"/> entries (else
+        /// <see cref="KodawariStatus.BufferTooSmall"/>). Returns how many were written. Allocation-free.</summary>
+        public unsafe int ReadWeights(Span<float> output)
+        {
+            float none;
+            uint written = 0;
+            fixed (float* p = &MemoryMarshal.GetReference(output))
+                Library.Check(NativeMethods.kdw_chain_read_weights(Ptr, id, p != null ? p : &none, Engine.Count(output.Length), &written));
+            return (int)written;
+        }
+
         public bool Equals(ViewDependentPhysicalObject other) { return engine == other.engine && id == other.id; }
         public override bool Equals(object obj) { return obj is ViewDependentPhysicalObject && Equals((ViewDependentPhysicalObject)obj); }
         public override int GetHashCode() { return id.GetHashCode(); }

@@ -14,6 +14,32 @@ namespace Kodawari.Unity
 
         public static Quaternion ToUnity(this Quat q) { return new Quaternion(q.X, q.Y, q.Z, q.W); }
 
+        public static Vec2 ToKodawari(this Vector2 v) { return new Vec2(v.x, v.y); }
+
+        public static Vector2 ToUnity(this Vec2 v) { return new Vector2(v.X, v.Y); }
+
+        /// <summary>The sketch tool's camera for a Unity camera: its transform's position and rotation unchanged
+        /// (Unity cameras look along +Z), the vertical field of view in radians or the orthographic size, and the
+        /// viewport in pixels (<c>pixelWidth</c> x <c>pixelHeight</c>). Stroke pixels are then top-left, y down:
+        /// <c>(x, pixelHeight - y)</c> of Unity's bottom-left screen coordinates.</summary>
+        public static StrokeCamera ToStrokeCamera(this Camera camera)
+        {
+            Transform t = camera.transform;
+            return camera.orthographic
+                ? StrokeCamera.FromUnityStyleOrthographic(t.position.ToKodawari(), t.rotation.ToKodawari(),
+                                                          camera.orthographicSize, camera.pixelWidth, camera.pixelHeight)
+                : StrokeCamera.FromUnityStyle(t.position.ToKodawari(), t.rotation.ToKodawari(),
+                                              camera.fieldOfView * Mathf.Deg2Rad, camera.pixelWidth, camera.pixelHeight);
+        }
+
+        /// <summary>Unity screen coordinates (origin bottom-left, pixels: <c>Input.mousePosition</c>,
+        /// <c>HandleUtility.GUIPointToScreenPixelCoordinate</c>) to the sketch tool's pixels (origin top-left, y
+        /// down) of <paramref name="camera"/>.</summary>
+        public static Vec2 ScreenToStrokePixel(this Camera camera, Vector2 screen)
+        {
+            return new Vec2(screen.x, camera.pixelHeight - screen.y);
+        }
+
         /// <summary>A transform's world pose (position and rotation; scale is not part of a pose).</summary>
         public static JointTransform WorldPose(this Transform t)
         {

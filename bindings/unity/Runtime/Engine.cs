@@ -233,6 +233,29 @@ namespace Kodawari.Unity
             }
         }
 
+        float[] weightScratch = new float[0];
+
+        /// <summary>The weights of <paramref name="chain"/>'s last blend (<c>ReadWeights</c>): <c>weights[0]</c> the base
+        /// shape's, then <c>weights[1 + v]</c> for <c>chain.viewShapes[v]</c> (0 for a view shape skipped at build).
+        /// <paramref name="weights"/> needs <c>1 + chain.viewShapes.Count</c> entries. False while the engine is not
+        /// running or the chain is not part of it. No allocation after the first call.</summary>
+        public bool TryReadWeights(ViewDependentPhysicalObject chain, float[] weights)
+        {
+            if (native == null || chain == null || weights == null) return false;
+            int index = Array.IndexOf(active, chain);
+            if (index < 0) return false;
+            ViewShape[] views = viewShapeHandles[index];
+            if (weights.Length < 1 + views.Length) return false;
+            if (weightScratch.Length < 1 + views.Length) weightScratch = new float[1 + views.Length];
+            int written = chainHandles[index].ReadWeights(weightScratch);
+            weights[0] = weightScratch[0];
+            int next = 1;
+            for (int v = 0; v < views.Length; v++)
+                weights[1 + v] = views[v].Engine != null && next < written ? weightScratch[next++] : 0f;
+            for (int k = 1 + views.Length; k < weights.Length; k++) weights[k] = 0f; // added since the build
+            return true;
+        }
+
         /// <summary>Marks settings and chain parameters for upload at the next LateUpdate (after changing fields
         /// from a script at run time).</summary>
         public void MarkSettingsChanged()

@@ -105,10 +105,19 @@ namespace Kodawari.Unity
         /// the direction is measured in <paramref name="viewReference"/>'s frame (the editor's capture button).</summary>
         public ViewShapeData CaptureViewShape(Vector3 cameraPosition, Transform viewReference)
         {
+            return CaptureViewShapeFromDirection(
+                (Quaternion.Inverse(viewReference.rotation) * (cameraPosition - viewReference.position)).normalized);
+        }
+
+        /// <summary>Captures the current joint poses as a view shape for <paramref name="viewDirection"/> (from the
+        /// view reference bone to the camera, in the bone's frame), e.g. the direction
+        /// <see cref="ShapeFromStroke"/> returned.</summary>
+        public ViewShapeData CaptureViewShapeFromDirection(Vector3 viewDirection)
+        {
             var joints = CollectJoints();
             var shape = new ViewShapeData
             {
-                direction = (Quaternion.Inverse(viewReference.rotation) * (cameraPosition - viewReference.position)).normalized,
+                direction = viewDirection,
                 influence = 1f,
                 positions = new Vector3[joints.Count],
                 rotations = new Quaternion[joints.Count],
@@ -121,6 +130,167 @@ namespace Kodawari.Unity
                 shape.rotations[i] = pose.Rotation.ToUnity();
             }
             return shape;
+        }
+
+        /// <summary>The <see cref="Engine"/> above this chain, or null.</summary>
+        public Engine FindEngine() { return GetComponentInParent<Engine>(); }
+
+        /// <summary>The bone view directions are measured from: the <see cref="Engine"/>'s view reference (or the
+        /// Engine's own transform); null without an Engine above this chain.</summary>
+        public Transform FindViewReference()
+        {
+            Engine engine = FindEngine();
+            if (engine == null) return null;
+            return engine.viewReference != null ? engine.viewReference : engine.transform;
+        }
+
+        /// <summary>The sketch tool (<see cref="Kodawari.Sketch.ShapeFromStroke"/>): the shape this chain takes so that,
+        /// seen through <paramref name="camera"/>, it follows <paramref name="strokePixels"/> (root to tip, pixels with
+        /// the origin at the top-left of the camera's viewport, y down; see
+        /// <see cref="Conversions.ScreenToStrokePixel"/>). Returns one pose per joint in the anchor frame (pass them to
+        /// <see cref="ApplyAnchorPose"/>) and the direction from the view reference bone to the camera in the bone's
+        /// frame. The root stays, every segment keeps its length. Throws <see cref="KodawariException"/> for a stroke
+        /// of fewer than 2 distinct points or a root behind the camera, InvalidOperationException without an anchor,
+        /// 2 joints or an Engine above.</summary>
+        public JointTransform[] ShapeFromStroke(Camera camera, IList<Vector2> strokePixels, out Vector3 viewDirection)
+        {
+            if (camera == null) throw new ArgumentNullException("camera");
+            if (strokePixels == null) throw new ArgumentNullException("strokePixels");
+            List<Transform> joints = CollectJoints();
+            Transform anchor = Anchor;
+            Transform reference = FindViewReference();
+            if (anchor == null || joints.Count < 2)
+                throw new InvalidOperationException(name + ": the chain needs a parent (its anchor) and at least 2 joints");
+            if (reference == null)
+                throw new InvalidOperationException(name + ": no Kodawari Engine above the chain (its view reference bone)");
+
+            var current = new JointTransform[joints.Count];
+            for (int i = 0; i < joints.Count; i++) current[i] = joints[i].WorldPose();
+            var stroke = new Vec2[strokePixels.Count];
+            for (int i = 0; i < stroke.Length; i++) stroke[i] = strokePixels[i].ToKodawari();
+            var result = new JointTransform[joints.Count];
+            Vec3 direction;
+            Kodawari.Sketch.ShapeFromStroke(camera.ToStrokeCamera(), current, anchor.WorldPose(), reference.WorldPose(),
+                                            stroke, result, out direction);
+            viewDirection = direction.ToUnity();
+            return result;
+        }
+
+        /// <summary>Poses the joints as <paramref name="anchorJoints"/> (anchor frame, root first, e.g. from
+        /// <see cref="ShapeFromStroke"/>) by setting local rotations only, root to tip: the hierarchy keeps its
+        /// bone lengths and every child follows. Record the joints for Undo first in the editor.</summary>
+        public void ApplyAnchorPose(IList<JointTransform> anchorJoints)
+        {
+            List<Transform> joints = CollectJoints();
+            Transform anchor = Anchor;
+            if (anchor == null) return;
+            for (int i = 0; i < joints.Count && i < anchorJoints.Count; i++)
+            {
+                Quaternion world = anchor.rotation * anchorJoints[i].Rotation.ToUnity();
+                Transform parent = joints[i].parent;
+                joints[i].localRotation = parent != null ? Quaternion.Inverse(parent.rotation) * world : world;
+            }
+        }
+
+        // ---- gizmos ----
+
+        static readonly Color ChainColor = new Color(1f, 0.55f, 0.1f, 1f);
+        static readonly Color ViewColor = new Color(0.2f, 0.8f, 1f, 1f);
+        float[] gizmoWeights = new float[0];
+
+        /// <summary>The weights the gizmos show, base shape first then one per entry of <see cref="viewShapes"/>
+        /// (the array is reused). While playing: the engine's last blend (<c>ReadWeights</c>), and
+        /// <paramref name="live"/> is true. Otherwise a preview: the engine's weight formula (SPEC 3.2,
+        /// <c>((dot(d_i, d) + 1) / 2)^influence</c>, normalised when they sum past 1) for a camera at
+        /// <paramref name="viewerPosition"/>.</summary>
+        public float[] GizmoWeights(Vector3 viewerPosition, out bool live)
+        {
+            int count = 1 + viewShapes.Count;
+            if (gizmoWeights.Length != count) gizmoWeights = new float[count];
+            Engine engine = FindEngine();
+            live = Application.isPlaying && engine != null && engine.TryReadWeights(this, gizmoWeights);
+            if (live) return gizmoWeights;
+
+            Transform reference = FindViewReference();
+            Vector3 d = reference != null
+                ? (Quaternion.Inverse(reference.rotation) * (viewerPosition - reference.position)).normalized
+                : Vector3.zero;
+            float sum = 0f;
+            for (int v = 0; v < viewShapes.Count; v++)
+            {
+                ViewShapeData shape = viewShapes[v];
+                float w = d.sqrMagnitude > 0f && shape.direction.sqrMagnitude > 0f
+                    ? Mathf.Pow(Mathf.Clamp01((Vector3.Dot(shape.direction.normalized, d) + 1f) * 0.5f), Mathf.Max(shape.influence, 1e-3f))
+                    : 0f;
+                gizmoWeights[1 + v] = w;
+                sum += w;
+            }
+            if (sum > 1f)
+            {
+                for (int v = 1; v < count; v++) gizmoWeights[v] /= sum;
+                sum = 1f;
+            }
+            gizmoWeights[0] = 1f - sum;
+            return gizmoWeights;
+        }
+
+        /// <summary>The size of the view gizmo: a third of the chain's length (at least 5 cm).</summary>
+        public float GizmoSize()
+        {
+            List<Transform> joints = CollectJoints();
+            float length = 0f;
+            for (int i = 1; i < joints.Count; i++) length += (joints[i].position - joints[i - 1].position).magnitude;
+            return Mathf.Max(length / 3f, 0.05f);
+        }
+
+        /// <summary>The chain (lines between joints) and, at the view reference bone, a sphere with one arrow per view
+        /// shape: its direction, its length scaled by its weight (live while playing, a preview for the camera
+        /// drawing the gizmo otherwise). The editor adds a label with the weights.</summary>
+        void OnDrawGizmosSelected()
+        {
+            List<Transform> joints = CollectJoints();
+            Gizmos.color = ChainColor;
+            for (int i = 0; i < joints.Count; i++)
+            {
+                if (i > 0) Gizmos.DrawLine(joints[i - 1].position, joints[i].position);
+                Gizmos.DrawWireSphere(joints[i].position, Mathf.Max(radius, 0.002f));
+            }
+
+            Transform reference = FindViewReference();
+            if (reference == null) return;
+            float size = GizmoSize();
+            Camera viewer = Camera.current;
+            bool live;
+            float[] weights = GizmoWeights(viewer != null ? viewer.transform.position : reference.position, out live);
+            Gizmos.color = ViewColor;
+            Gizmos.DrawWireSphere(reference.position, 0.15f * size);
+            for (int v = 0; v < viewShapes.Count; v++)
+            {
+                if (viewShapes[v].direction.sqrMagnitude <= 0f) continue;
+                Vector3 direction = (reference.rotation * viewShapes[v].direction).normalized;
+                Vector3 from = reference.position + direction * (0.15f * size);
+                DrawArrow(from, direction * (size * weights[1 + v]));
+            }
+        }
+
+        static void DrawArrow(Vector3 from, Vector3 vector)
+        {
+            float length = vector.magnitude;
+            if (length < 1e-5f)
+            {
+                Gizmos.DrawWireSphere(from, 0.01f);
+                return;
+            }
+            Vector3 to = from + vector;
+            Vector3 direction = vector / length;
+            Vector3 side = Vector3.Cross(direction, Mathf.Abs(direction.y) < 0.9f ? Vector3.up : Vector3.right).normalized;
+            Vector3 other = Vector3.Cross(direction, side);
+            float head = Mathf.Min(0.25f * length, 0.05f);
+            Gizmos.DrawLine(from, to);
+            Gizmos.DrawLine(to, to - direction * head + side * (0.5f * head));
+            Gizmos.DrawLine(to, to - direction * head - side * (0.5f * head));
+            Gizmos.DrawLine(to, to - direction * head + other * (0.5f * head));
+            Gizmos.DrawLine(to, to - direction * head - other * (0.5f * head));
         }
 
         /// <summary>Poses the joints as <paramref name="shape"/> (editor preview).</summary>

@@ -54,9 +54,9 @@ typedef struct kdw_chain_def {
     // Share of the motion caused by a changing rest shape that is not turned into velocity, [0, 1].
     // Default 1.
     float momentum_suppression;
-    // Mass per particle, kg, > 0. Default 1.
+    // Mass per particle, kg, in [1e-6, 1e6]. Default 1.
     float mass;
-    // Particle radius, m, >= 0 (weight of orientations in shape matching). Default 0.02.
+    // Particle radius, m, in [0, 1e6] (weight of orientations in shape matching). Default 0.02.
     float radius;
     // Multiplier on the engine's gravity, in [-100, 100]. Default 1.
     float gravity_scale;
@@ -84,7 +84,8 @@ typedef struct kdw_quat {
     float w;
 } kdw_quat;
 
-// Position + rotation: 28 bytes, the layout of a Unity `Vector3` followed by a `Quaternion`.
+// Position + rotation: 28 bytes, the layout of a Unity `Vector3` followed by a `Quaternion`. Positions
+// must be finite and within ±1e9 m.
 typedef struct kdw_transform {
     struct kdw_vec3 position;
     struct kdw_quat rotation;
@@ -97,7 +98,7 @@ typedef uint64_t kdw_chain_id;
 typedef struct kdw_engine_def {
     // `sizeof(kdw_engine_def)`; lets the struct grow without breaking old callers.
     uint32_t struct_size;
-    // World gravity, m/s². Default (0, -9.81, 0).
+    // World gravity, m/s², each component within ±1e6. Default (0, -9.81, 0).
     struct kdw_vec3 gravity;
     // Internal fixed steps per simulated second, Hz, in [30, 10000]. Default 240.
     float substep_rate;

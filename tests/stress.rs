@@ -420,10 +420,12 @@ fn parameter_extremes_long() {
 /// counter and in the energy balance (kinetic + gravitational from read-back positions), which a 100-joint
 /// rope keeps to 3.5e-3 of its peak kinetic energy.
 #[test]
-#[ignore = "BUG: 1000-joint limp rope (5 mm segments) released straight at 45 degrees, still root, defaults: \
-            479 solver fallbacks in 2 s (every substep), total energy off by 0.37 of the peak kinetic energy; \
-            200 joints (2.5 cm): 309 fallbacks, energy off by 1.0x the peak kinetic energy (1.7e5 J); 100 joints: \
-            none, 3.5e-3 (bar: no fallbacks, energy within 1e-2)"]
+#[ignore = "BUG (open): 1000-joint limp rope (5 mm segments) released straight at 45 degrees, still root, \
+            defaults: 479 solver fallbacks in 2 s (every substep after the first), total energy off by 0.37 of \
+            the peak kinetic energy; 200 joints: energy off by 1.0x; 100 joints: fine. Diagnosed: the Newton \
+            iteration of the coupled distance solve diverges on long pinned chains (the needed corrections add \
+            up along the rope, shrinking its convergence radius); moving the solve to f64 and falling back to \
+            Newton along the current bonds did not help. Needs a damped Newton (line search)."]
 fn long_chain_at_an_angle_stays_inextensible() {
     let mut failures = Vec::new();
     for (joints, segment) in [(1000usize, 0.005f32), (200, 0.025), (100, 0.05)] {
@@ -528,9 +530,6 @@ fn world_scale_covariance() {
 }
 
 #[test]
-#[ignore = "BUG: world scale 1e-3 (chain 0.35 mm, gravity and radius scaled) deviates from the unscaled run \
-            by 6.2e-3 chain lengths (0.16 rad in local rotations) within 2 s (bar 1e-4; 1e-2..1e4 stay <= 7e-5); \
-            likely the absolute 1e-9 regulariser in polar::extract_rotation, comparable to A at that scale"]
 fn world_scale_millimetre_covariance() {
     let length = chain_length(&test_chain(9, 0.05));
     let reference = sway_scene(1.0, Vec3::ZERO, None, 120);

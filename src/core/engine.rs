@@ -10,7 +10,7 @@ use super::arena::{Arena, Id, Kind};
 use super::chain::{Chain, ViewShape, ViewShapeId, relative_rotation};
 use super::error::{Error, Result};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
-use super::params::{AnchorSource, ChainParams, EngineSettings};
+use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE};
 use super::rod::{RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
 
@@ -631,12 +631,17 @@ fn is_teleport(from: &Transform, to: &Transform, settings: &EngineSettings) -> b
         || rotation_angle(from.rotation.inverse() * to.rotation) > settings.teleport_angle
 }
 
+/// Finite and within the coordinate range the solver can subtract and square without overflow.
+pub(crate) fn within_world(p: Vec3) -> bool {
+    p.is_finite() && p.abs().max_element() <= MAX_COORDINATE
+}
+
 fn validate_step(dt: f32, camera: Vec3, view_reference: &Transform) -> Result<Transform> {
     if !(dt.is_finite() && dt >= 0.0) {
         return Err(Error::invalid_argument(format!("dt must be finite and >= 0, got {dt}")));
     }
-    if !camera.is_finite() {
-        return Err(Error::invalid_argument("camera position must be finite"));
+    if !within_world(camera) {
+        return Err(Error::invalid_argument(format!("camera position must be finite and within +-{MAX_COORDINATE} m")));
     }
     validate_transform(view_reference).map_err(|e| Error::invalid_argument(format!("view reference: {e}")))
 }
@@ -645,6 +650,9 @@ fn validate_step(dt: f32, camera: Vec3, view_reference: &Transform) -> Result<Tr
 pub(crate) fn validate_transform(t: &Transform) -> Result<Transform> {
     if !t.is_finite() {
         return Err(Error::invalid_argument("non-finite position or rotation"));
+    }
+    if !within_world(t.position) {
+        return Err(Error::invalid_argument(format!("position beyond +-{MAX_COORDINATE} m")));
     }
     let rotation =
         normalized_rotation(t.rotation).ok_or_else(|| Error::invalid_argument("null rotation quaternion"))?;

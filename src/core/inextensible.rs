@@ -3,27 +3,28 @@
 //! scheme symplectic and second order; the coupled system is tridiagonal, so a Newton iteration is one
 //! O(n) Thomas solve.
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 
 /// Relative error of `|b|^2 / l^2 - 1` below which a bond counts as satisfied (about 5e-7 in length:
 /// the float32 floor).
-const TOLERANCE: f32 = 1e-6;
+const TOLERANCE: f64 = 1e-9;
 const MAX_NEWTON_ITERATIONS: usize = 8;
 /// Largest error still accepted as a rounding floor when Newton stops improving.
-const STAGNATION_LIMIT: f32 = 1e-3;
+const STAGNATION_LIMIT: f64 = 1e-3;
 const FALLBACK_SWEEPS: usize = 64;
 
 /// Reusable buffers, one entry per bond.
 #[derive(Default)]
 pub struct ConstraintScratch {
-    lambda: Vec<f32>,
-    bonds: Vec<Vec3>,
-    residual: Vec<f32>,
-    diag: Vec<f32>,
-    lower: Vec<f32>,
-    upper: Vec<f32>,
-    c_prime: Vec<f32>,
-    d_prime: Vec<f32>,
+    lambda: Vec<f64>,
+    bonds: Vec<DVec3>,
+    directions: Vec<DVec3>,
+    residual: Vec<f64>,
+    diag: Vec<f64>,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    c_prime: Vec<f64>,
+    d_prime: Vec<f64>,
 }
 
 impl ConstraintScratch {
@@ -42,7 +43,8 @@ impl ConstraintScratch {
             }
         }
         if self.bonds.len() < bonds {
-            self.bonds.resize(bonds, Vec3::ZERO);
+            self.bonds.resize(bonds, DVec3::ZERO);
+            self.directions.resize(bonds, DVec3::ZERO);
         }
     }
 }
@@ -54,38 +56,57 @@ fn inv_mass<T: Default>(j: usize, dynamic_inv_mass: T) -> T {
 }
 
 /// Moves `p` so that `|p[k+1] - p[k]| = lengths[k]` for every bond, correcting along the previous
-/// positions' bonds `x[k+1] - x[k]`. Particle 0 never moves. Returns `false` when the direct solve failed
-/// (a bond turned by about 90 degrees in one substep) and a Gauss-Seidel fallback along current bonds was
-/// used instead.
+/// positions' bonds `x[k+1] - x[k]`. Particle 0 never moves. Returns `false` when that direct solve failed
+/// (a bond turned by about 90 degrees in one substep, as at the tip of a whipping rope) and the fallback
+/// ran: the same Newton solve along the current bonds (always well conditioned, not symplectic), then, if
+/// even that fails, Gauss-Seidel projection.
 pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f32, s: &mut ConstraintScratch) -> bool {
     let m = lengths.len();
     debug_assert!(x.len() == m + 1 && p.len() == m + 1);
     s.reserve(m);
-    let w = |j: usize| inv_mass(j, dynamic_inv_mass);
-    let d = |k: usize| (x[k + 1] - x[k]).as_vec3();
-    s.lambda[..m].fill(0.0);
+    for k in 0..m {
+        s.directions[k] = x[k + 1] - x[k];
+    }
+    if newton_along_directions(p, lengths, dynamic_inv_mass as f64, s) {
+        return true;
+    }
+    for k in 0..m {
+        s.directions[k] = p[k + 1] - p[k];
+    }
+    if !newton_along_directions(p, lengths, dynamic_inv_mass as f64, s) {
+        project_gauss_seidel(p, lengths, dynamic_inv_mass);
+    }
+    false
+}
 
+/// Newton iterations on the multipliers of corrections along `s.directions` (one per bond); applies them
+/// to `p` and returns `true` when converged, leaves `p` untouched otherwise.
+fn newton_along_directions(p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f64, s: &mut ConstraintScratch) -> bool {
+    let m = lengths.len();
+    let w = |j: usize| inv_mass(j, dynamic_inv_mass);
+    s.lambda[..m].fill(0.0);
     let mut converged = false;
-    let mut previous_worst = f32::INFINITY;
+    let mut previous_worst = f64::INFINITY;
     for _ in 0..MAX_NEWTON_ITERATIONS {
         // Bond vectors and residuals under the current multipliers.
-        let mut worst = 0.0f32;
+        let d = &s.directions;
+        let mut worst = 0.0f64;
         for k in 0..m {
-            let mut b = (p[k + 1] - p[k]).as_vec3() + d(k) * ((w(k) + w(k + 1)) * s.lambda[k]);
+            let mut b = p[k + 1] - p[k] + d[k] * ((w(k) + w(k + 1)) * s.lambda[k]);
             if k > 0 {
-                b -= d(k - 1) * (w(k) * s.lambda[k - 1]);
+                b -= d[k - 1] * (w(k) * s.lambda[k - 1]);
             }
             if k + 1 < m {
-                b -= d(k + 1) * (w(k + 1) * s.lambda[k + 1]);
+                b -= d[k + 1] * (w(k + 1) * s.lambda[k + 1]);
             }
-            let l2 = lengths[k] * lengths[k];
+            let l2 = lengths[k] as f64 * lengths[k] as f64;
             let f = b.length_squared() - l2;
             s.bonds[k] = b;
             s.residual[k] = -f;
             worst = worst.max((f / l2).abs());
         }
         // Newton converges quadratically, so an iteration that fails to halve the error has reached the
-        // rounding floor of float32 positions (which grows with the distance from the origin).
+        // rounding floor. (The system is solved in f64: its condition grows like n^2.)
         if worst <= TOLERANCE || (worst > 0.5 * previous_worst && worst < STAGNATION_LIMIT) {
             converged = true;
             break;
@@ -94,27 +115,26 @@ pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f3
         // Jacobian of F_k = |b_k|^2 - l_k^2 with respect to the multipliers: tridiagonal.
         for k in 0..m {
             let b = s.bonds[k];
-            s.diag[k] = 2.0 * (w(k) + w(k + 1)) * b.dot(d(k));
-            s.lower[k] = if k > 0 { -2.0 * w(k) * b.dot(d(k - 1)) } else { 0.0 };
-            s.upper[k] = if k + 1 < m { -2.0 * w(k + 1) * b.dot(d(k + 1)) } else { 0.0 };
+            s.diag[k] = 2.0 * (w(k) + w(k + 1)) * b.dot(d[k]);
+            s.lower[k] = if k > 0 { -2.0 * w(k) * b.dot(d[k - 1]) } else { 0.0 };
+            s.upper[k] = if k + 1 < m { -2.0 * w(k + 1) * b.dot(d[k + 1]) } else { 0.0 };
         }
         if !thomas_solve(s, m) {
             break;
         }
     }
-    if converged {
-        for j in 1..=m {
-            let mut dp = Vec3::ZERO;
-            dp += d(j - 1) * s.lambda[j - 1];
-            if j < m {
-                dp -= d(j) * s.lambda[j];
-            }
-            p[j] += (dp * w(j)).as_dvec3();
-        }
-        return true;
+    if !converged {
+        return false;
     }
-    project_gauss_seidel(p, lengths, dynamic_inv_mass);
-    false
+    let d = &s.directions;
+    for j in 1..=m {
+        let mut dp = d[j - 1] * s.lambda[j - 1];
+        if j < m {
+            dp -= d[j] * s.lambda[j];
+        }
+        p[j] += dp * w(j);
+    }
+    true
 }
 
 /// Solves the tridiagonal system in `s` (diag, lower, upper, residual as right-hand side) and adds the
@@ -122,7 +142,7 @@ pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f3
 // `!(x > y)` on purpose: a NaN must fail the check too.
 #[allow(clippy::neg_cmp_op_on_partial_ord)]
 fn thomas_solve(s: &mut ConstraintScratch, m: usize) -> bool {
-    let scale = s.diag[..m].iter().fold(0.0f32, |a, b| a.max(b.abs()));
+    let scale = s.diag[..m].iter().fold(0.0f64, |a, b| a.max(b.abs()));
     let tiny = scale * 1e-7;
     if !(scale > 0.0) || !(s.diag[0].abs() > tiny) {
         return false;
@@ -137,7 +157,7 @@ fn thomas_solve(s: &mut ConstraintScratch, m: usize) -> bool {
         s.c_prime[k] = s.upper[k] / den;
         s.d_prime[k] = (s.residual[k] - s.lower[k] * s.d_prime[k - 1]) / den;
     }
-    let mut next = 0.0f32;
+    let mut next = 0.0f64;
     for k in (0..m).rev() {
         let delta = s.d_prime[k] - s.c_prime[k] * next;
         if !delta.is_finite() {

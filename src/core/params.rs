@@ -16,7 +16,7 @@ pub enum AnchorSource {
 /// Engine-wide settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EngineSettings {
-    /// World gravity, m/s².
+    /// World gravity, m/s², each component within ±1e6.
     pub gravity: Vec3,
     /// Internal fixed steps per simulated second, Hz. Range [30, 10000].
     pub substep_rate: f32,
@@ -52,7 +52,9 @@ fn check(ok: bool, message: impl FnOnce() -> String) -> Result<()> {
 
 impl EngineSettings {
     pub fn validate(&self) -> Result<()> {
-        check(self.gravity.is_finite(), || "gravity must be finite".into())?;
+        check(self.gravity.is_finite() && self.gravity.abs().max_element() <= MAX_GRAVITY, || {
+            format!("gravity components must be within +-{MAX_GRAVITY} m/s^2")
+        })?;
         check((30.0..=10000.0).contains(&self.substep_rate), || {
             format!("substep_rate {} outside [30, 10000] Hz", self.substep_rate)
         })?;
@@ -87,14 +89,23 @@ pub struct ChainParams {
     pub damping: f32,
     /// Share of the motion caused by a changing rest shape that is not turned into velocity, [0, 1].
     pub momentum_suppression: f32,
-    /// Mass of each particle, kg. > 0. (Uniform masses: only matters once forces other than gravity act.)
+    /// Mass of each particle, kg, in [1e-6, 1e6]. (Uniform masses: only matters once forces other than gravity act.)
     pub mass: f32,
-    /// Particle radius, m (>= 0): weight of orientations in shape matching, later the collision radius.
+    /// Particle radius, m, in [0, 1e6]: weight of orientations in shape matching, later the collision radius.
     pub radius: f32,
     /// Multiplier on the engine's gravity, dimensionless. Range [-100, 100].
     pub gravity_scale: f32,
     pub anchor: AnchorSource,
 }
+
+/// Ranges that keep every product in the solver (radius², 1/mass, g·h², mass·v²) far from float32
+/// overflow, while covering characters from millimetres to kilometres.
+pub const MAX_GRAVITY: f32 = 1e6;
+pub const MIN_MASS: f32 = 1e-6;
+pub const MAX_MASS: f32 = 1e6;
+pub const MAX_RADIUS: f32 = 1e6;
+/// Largest accepted coordinate of any position (m). Beyond it float32 resolves less than 60 m anyway.
+pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Angular frequency (rad/s) of each shape-matching group's pull at stiffness 0.5 (10 Hz). The bending
 /// modes of a whole chain are slower: a group sees only its local share of a global shape error.
@@ -121,9 +132,11 @@ impl ChainParams {
         check((0.0..=1.0).contains(&self.momentum_suppression), || {
             format!("momentum_suppression {} outside [0, 1]", self.momentum_suppression)
         })?;
-        check(self.mass > 0.0 && self.mass.is_finite(), || format!("mass {} must be finite and > 0", self.mass))?;
-        check(self.radius >= 0.0 && self.radius.is_finite(), || {
-            format!("radius {} must be finite and >= 0", self.radius)
+        check((MIN_MASS..=MAX_MASS).contains(&self.mass), || {
+            format!("mass {} outside [{MIN_MASS}, {MAX_MASS}] kg", self.mass)
+        })?;
+        check((0.0..=MAX_RADIUS).contains(&self.radius), || {
+            format!("radius {} outside [0, {MAX_RADIUS}] m", self.radius)
         })?;
         check((-100.0..=100.0).contains(&self.gravity_scale), || {
             format!("gravity_scale {} outside [-100, 100]", self.gravity_scale)

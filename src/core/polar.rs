@@ -11,10 +11,14 @@ const CONVERGED_ANGLE: f32 = 1e-7;
 /// Improves `q` in place towards the rotation part of `a`, for at most `max_iterations` iterations.
 #[inline]
 pub fn extract_rotation(a: &Mat3, q: &mut Quat, max_iterations: u32) {
+    // The guard against a vanishing denominator scales with the matrix, so a millimetre-sized chain (entries
+    // ~1e-7) is treated exactly like a metre-sized one.
+    let guard = 1e-9 * (a.x_axis.length_squared() + a.y_axis.length_squared() + a.z_axis.length_squared()).sqrt()
+        + f32::MIN_POSITIVE;
     for _ in 0..max_iterations {
         let r = Mat3::from_quat(*q);
         let omega_num = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
-        let omega_den = (r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis)).abs() + 1e-9;
+        let omega_den = (r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis)).abs() + guard;
         let omega = omega_num / omega_den;
         let angle = omega.length();
         if angle < CONVERGED_ANGLE {

@@ -8,6 +8,7 @@ use glam::{Quat, Vec3};
 
 use super::error::{Error, Result};
 use super::math::{Transform, direction, normalized_rotation, shortest_arc};
+use super::params::MAX_COORDINATE;
 
 /// A validated shape: positions and unit orientations in the anchor frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,6 +32,9 @@ impl Shape {
         for (i, joint) in joints.iter().enumerate() {
             if !joint.is_finite() {
                 return Err(Error::invalid_argument(format!("joint {i} has a non-finite position or rotation")));
+            }
+            if joint.position.abs().max_element() > MAX_COORDINATE {
+                return Err(Error::invalid_argument(format!("joint {i} lies beyond +-{MAX_COORDINATE} m")));
             }
             let Some(rotation) = normalized_rotation(joint.rotation) else {
                 return Err(Error::invalid_argument(format!("joint {i} has a null rotation quaternion")));

@@ -25,7 +25,8 @@ pub struct kdw_quat {
     pub w: f32,
 }
 
-/// Position + rotation: 28 bytes, the layout of a Unity `Vector3` followed by a `Quaternion`.
+/// Position + rotation: 28 bytes, the layout of a Unity `Vector3` followed by a `Quaternion`. Positions
+/// must be finite and within ±1e9 m.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct kdw_transform {
@@ -49,7 +50,7 @@ pub const KDW_ANCHOR_OWN: u32 = 1;
 pub struct kdw_engine_def {
     /// `sizeof(kdw_engine_def)`; lets the struct grow without breaking old callers.
     pub struct_size: u32,
-    /// World gravity, m/s². Default (0, -9.81, 0).
+    /// World gravity, m/s², each component within ±1e6. Default (0, -9.81, 0).
     pub gravity: kdw_vec3,
     /// Internal fixed steps per simulated second, Hz, in [30, 10000]. Default 240.
     pub substep_rate: f32,
@@ -83,9 +84,9 @@ pub struct kdw_chain_def {
     /// Share of the motion caused by a changing rest shape that is not turned into velocity, [0, 1].
     /// Default 1.
     pub momentum_suppression: f32,
-    /// Mass per particle, kg, > 0. Default 1.
+    /// Mass per particle, kg, in [1e-6, 1e6]. Default 1.
     pub mass: f32,
-    /// Particle radius, m, >= 0 (weight of orientations in shape matching). Default 0.02.
+    /// Particle radius, m, in [0, 1e6] (weight of orientations in shape matching). Default 0.02.
     pub radius: f32,
     /// Multiplier on the engine's gravity, in [-100, 100]. Default 1.
     pub gravity_scale: f32,

@@ -434,7 +434,8 @@ namespace Kodawari.Native
     }
 
     /// <summary>
-    ///  Position + rotation: 28 bytes, the layout of a Unity `Vector3` followed by a `Quaternion`.
+    ///  Position + rotation: 28 bytes, the layout of a Unity `Vector3` followed by a `Quaternion`. Positions
+    ///  must be finite and within ±1e9 m.
     /// </summary>
     [StructLayout(LayoutKind.Sequential)]
     internal unsafe partial struct kdw_transform
@@ -454,7 +455,7 @@ namespace Kodawari.Native
         /// </summary>
         public uint struct_size;
         /// <summary>
-        ///  World gravity, m/s². Default (0, -9.81, 0).
+        ///  World gravity, m/s², each component within ±1e6. Default (0, -9.81, 0).
         /// </summary>
         public kdw_vec3 gravity;
         /// <summary>
@@ -512,11 +513,11 @@ namespace Kodawari.Native
         /// </summary>
         public float momentum_suppression;
         /// <summary>
-        ///  Mass per particle, kg, &gt; 0. Default 1.
+        ///  Mass per particle, kg, in [1e-6, 1e6]. Default 1.
         /// </summary>
         public float mass;
         /// <summary>
-        ///  Particle radius, m, &gt;= 0 (weight of orientations in shape matching). Default 0.02.
+        ///  Particle radius, m, in [0, 1e6] (weight of orientations in shape matching). Default 0.02.
         /// </summary>
         public float radius;
         /// <summary>

@@ -453,22 +453,12 @@ impl Engine {
 
     /// World transforms of every joint of every chain, in creation order. Returns how many were written.
     pub fn read_world(&self, out: &mut [Transform]) -> Result<usize> {
-        let mut i = 0;
-        self.for_each_world_transform(out.len(), |t| {
-            out[i] = t;
-            i += 1;
-        })?;
-        Ok(i)
+        fill_slice(out, |capacity, f| self.for_each_world_transform(capacity, f))
     }
 
     /// Local rotations (see [`for_each_local_rotation`](Self::for_each_local_rotation)) into `out`.
     pub fn read_local_rotations(&self, out: &mut [Quat]) -> Result<usize> {
-        let mut i = 0;
-        self.for_each_local_rotation(out.len(), |q| {
-            out[i] = q;
-            i += 1;
-        })?;
-        Ok(i)
+        fill_slice(out, |capacity, f| self.for_each_local_rotation(capacity, f))
     }
 
     /// Calls `f` with the world transform of each joint of one chain; fails without calling it when
@@ -502,22 +492,12 @@ impl Engine {
 
     /// World transforms of one chain's joints into `out`; returns how many were written.
     pub fn read_chain_world(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
-        let mut i = 0;
-        self.for_each_chain_world_transform(id, out.len(), |t| {
-            out[i] = t;
-            i += 1;
-        })?;
-        Ok(i)
+        fill_slice(out, |capacity, f| self.for_each_chain_world_transform(id, capacity, f))
     }
 
     /// The rest shape a chain is currently pulled towards (anchor frame) into `out`.
     pub fn chain_rest_shape(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
-        let mut i = 0;
-        self.for_each_chain_rest_transform(id, out.len(), |t| {
-            out[i] = t;
-            i += 1;
-        })?;
-        Ok(i)
+        fill_slice(out, |capacity, f| self.for_each_chain_rest_transform(id, capacity, f))
     }
 
     /// Calls `f` with the weights of the chain's last blend: the base shape's first, then each view shape's in
@@ -614,6 +594,18 @@ impl Engine {
         words.hash(&mut hasher);
         hasher.finish()
     }
+}
+
+/// Runs a visitor (`for_each_*`) into `out`, in order; returns how many items were stored. The visitor
+/// checks the capacity before it calls back.
+fn fill_slice<T>(out: &mut [T], visit: impl FnOnce(usize, &mut dyn FnMut(T)) -> Result<()>) -> Result<usize> {
+    let capacity = out.len();
+    let mut stored = 0;
+    visit(capacity, &mut |item| {
+        out[stored] = item;
+        stored += 1;
+    })?;
+    Ok(stored)
 }
 
 fn check_chain_capacity(chain: &Chain, capacity: usize) -> Result<()> {

@@ -1,0 +1,2 @@
+//! Placeholder: the performance benchmark is being written.
+fn main() {}

@@ -29,14 +29,36 @@
 // `Camera.transform.position` and `.rotation` unchanged).
 #define KDW_CAMERA_FORWARD_POSITIVE_Z 1
 
+// A teleport moves the chain rigidly with its anchor, keeping its shape and adding no energy.
+#define KDW_TELEPORT_CARRY_SHAPE 0
+
+// A teleport puts the chain back to its rest shape under the new anchor, at rest.
+#define KDW_TELEPORT_RESET 1
+
 // The chain's anchor is the view reference joint K given with each step.
 #define KDW_ANCHOR_VIEW_REFERENCE 0
 
 // The chain's anchor is its own entry in `kdw_engine_set_anchors`.
 #define KDW_ANCHOR_OWN 1
 
+// Keeps particles outside a ball of `radius`.
+#define KDW_COLLIDER_SPHERE 0
+
+// Keeps particles outside a capsule: `radius` around the segment from -`half_height` to +`half_height`
+// on the collider's local Y axis.
+#define KDW_COLLIDER_CAPSULE 1
+
+// Keeps particles on the local +Y side of the plane through the collider's origin.
+#define KDW_COLLIDER_PLANE 2
+
+// Keeps particles inside a ball of `radius`.
+#define KDW_COLLIDER_INSIDE_SPHERE 3
+
+// Keeps particles inside a capsule.
+#define KDW_COLLIDER_INSIDE_CAPSULE 4
+
 // Bumped on every incompatible change of the C ABI (signatures, struct layouts, semantics).
-#define KDW_ABI_VERSION 1
+#define KDW_ABI_VERSION 2
 
 // One per character: owns chains and view shapes, gravity and solver settings. Opaque.
 typedef struct kdw_engine kdw_engine;
@@ -56,12 +78,19 @@ typedef struct kdw_chain_def {
     float momentum_suppression;
     // Mass per particle, kg, in [1e-6, 1e6]. Default 1.
     float mass;
-    // Particle radius, m, in [0, 1e6] (weight of orientations in shape matching). Default 0.02.
+    // Particle radius in character units (× the engine's `scale` m), in [0, 1e6]: every joint's collision
+    // radius unless `kdw_chain_set_joint_radii` set them, and the weight of orientations in shape matching.
+    // Default 0.02.
     float radius;
     // Multiplier on the engine's gravity, in [-100, 100]. Default 1.
     float gravity_scale;
     // `KDW_ANCHOR_VIEW_REFERENCE` (default) or `KDW_ANCHOR_OWN`.
     uint32_t anchor;
+    // Collision layers the chain collides with (a collider whose `layers` share a bit). 0: no collisions,
+    // and no collision cost. Default 0xFFFFFFFF.
+    uint32_t collision_mask;
+    // Coulomb friction against colliders, in [0, 10]. Default 0.3.
+    float friction;
 } kdw_chain_def;
 
 // Result of every fallible call: 0 is success, negative values are errors (`KDW_STATUS_*`). Kept a plain
@@ -94,11 +123,30 @@ typedef struct kdw_transform {
 // A chain (`ViewDependentPhysicalObject`). Index + generation + owner; 0 is the null id.
 typedef uint64_t kdw_chain_id;
 
+// A collider; obtain defaults from `kdw_collider_def_default()`.
+typedef struct kdw_collider_def {
+    // `sizeof(kdw_collider_def)`.
+    uint32_t struct_size;
+    // One of `KDW_COLLIDER_*`. Default `KDW_COLLIDER_SPHERE`.
+    uint32_t shape;
+    // Sphere and capsule radius, m (world units), in [0, 1e6]; > 0 for inside colliders. Default 0.1.
+    float radius;
+    // Capsule half length of the axis, m, in [0, 1e6]. Default 0.
+    float half_height;
+    // Initial world pose; `kdw_engine_set_collider_transforms` moves it every frame.
+    struct kdw_transform transform;
+    // Layers the collider is on: it affects chains whose `collision_mask` shares a bit. Default 1.
+    uint32_t layers;
+} kdw_collider_def;
+
+// A collider. 0 is the null id.
+typedef uint64_t kdw_collider_id;
+
 // Engine settings; obtain defaults from `kdw_engine_def_default()`.
 typedef struct kdw_engine_def {
     // `sizeof(kdw_engine_def)`; lets the struct grow without breaking old callers.
     uint32_t struct_size;
-    // World gravity, m/s², each component within ±1e6. Default (0, -9.81, 0).
+    // World gravity in character units/s² (× `scale` m/s²), each component within ±1e6. Default (0, -9.81, 0).
     struct kdw_vec3 gravity;
     // Internal fixed steps per simulated second, Hz, in [30, 10000]. Default 240.
     float substep_rate;
@@ -109,12 +157,18 @@ typedef struct kdw_engine_def {
     uint32_t iterations;
     // Simulated seconds per second of `dt`, in [0, 100]; 0 pauses. Default 1.
     float time_scale;
-    // An anchor moving farther than this (m) in one step is a teleport: the chain is carried rigidly.
+    // An anchor moving farther than this in one step is a teleport, in character units (× `scale` m).
     // > 0; FLT_MAX disables. Default 1.
     float teleport_distance;
     // An anchor turning more than this (radians) in one step is a teleport. > 0; above pi disables.
     // Default pi/2.
     float teleport_angle;
+    // What a teleport does: `KDW_TELEPORT_CARRY_SHAPE` (default) or `KDW_TELEPORT_RESET`.
+    uint32_t teleport_mode;
+    // Size of the character relative to the units its parameters are tuned in, in [1e-6, 1e6]: multiplies
+    // gravity, `teleport_distance` and chain/joint radii, so a character scaled by 100 with scale 100 moves
+    // like the unscaled one. Transforms and collider sizes are world units. Default 1.
+    float scale;
 } kdw_engine_def;
 
 // Counters for profiling overlays.
@@ -127,7 +181,7 @@ typedef struct kdw_engine_stats {
     uint32_t substeps_last_step;
     // Chains that cost nothing in the last step (sleeping or disabled).
     uint32_t chains_asleep;
-    uint32_t reserved;
+    uint32_t collider_count;
     uint64_t substeps_total;
     // Internal steps where the direct inextensibility solve failed and a fallback ran.
     uint64_t solver_fallbacks;
@@ -135,6 +189,8 @@ typedef struct kdw_engine_stats {
     double time_dropped;
     // Simulated seconds advanced in total.
     double simulated_time;
+    // (segment or particle, collider) pairs tested by the contact pass in total.
+    uint64_t contact_pairs_tested;
 } kdw_engine_stats;
 
 // The camera a stroke was drawn in; obtain defaults from `kdw_stroke_camera_default()`.
@@ -263,6 +319,53 @@ kdw_status kdw_chain_read_rest_shape(const struct kdw_engine *engine,
 // Kinetic energy of the chain's dynamic joints, J (mass x velocity^2 / 2 summed).
 kdw_status kdw_chain_kinetic_energy(const struct kdw_engine *engine, kdw_chain_id chain, float *out_energy);
 
+// Per-joint collision radii in character units (× the engine's `scale` m), each in [0, 1e6]: `count` must
+// equal the chain's joint count, or be 0 to go back to the chain def's `radius` for every joint.
+kdw_status kdw_chain_set_joint_radii(struct kdw_engine *engine,
+                                     kdw_chain_id chain,
+                                     const float *radii,
+                                     uint32_t count);
+
+// The chain treats its anchor's motion in the next step as a teleport (the engine's `teleport_mode`).
+kdw_status kdw_chain_teleport(struct kdw_engine *engine, kdw_chain_id chain);
+
+// Default collider: a sphere of radius 0.1 m at the origin on layer 1.
+struct kdw_collider_def kdw_collider_def_default(void);
+
+// Creates a collider. Chains whose `collision_mask` shares a bit with its `layers` are kept out of it (or
+// inside it). `*out_collider` receives its id.
+kdw_status kdw_collider_create(struct kdw_engine *engine,
+                               const struct kdw_collider_def *def,
+                               kdw_collider_id *out_collider);
+
+// Destroys a collider. Later colliders keep their relative order in `kdw_engine_set_collider_transforms`.
+kdw_status kdw_collider_destroy(struct kdw_engine *engine, kdw_collider_id collider);
+
+// `*out_valid` = 1 if `collider` names a live collider of this engine, else 0.
+kdw_status kdw_collider_is_valid(const struct kdw_engine *engine,
+                                 kdw_collider_id collider,
+                                 uint32_t *out_valid);
+
+// Moves a collider to other layers.
+kdw_status kdw_collider_set_layers(struct kdw_engine *engine, kdw_collider_id collider, uint32_t layers);
+
+// Sets every collider's world pose for the next step: `count` must equal the collider count, entry i
+// belongs to the i-th collider in creation order. The step sweeps each collider from its last pose to
+// this one across its substeps (a jump beyond the teleport thresholds is not swept).
+kdw_status kdw_engine_set_collider_transforms(struct kdw_engine *engine,
+                                              const struct kdw_transform *transforms,
+                                              uint32_t count);
+
+// Number of colliders.
+kdw_status kdw_engine_collider_count(const struct kdw_engine *engine, uint32_t *out_count);
+
+// Collider ids in creation order (the order of `kdw_engine_set_collider_transforms`). `capacity` must be
+// at least the collider count.
+kdw_status kdw_engine_get_collider_ids(const struct kdw_engine *engine,
+                                       kdw_collider_id *out_ids,
+                                       uint32_t capacity,
+                                       uint32_t *out_written);
+
 // Default engine settings (240 Hz substeps, 2 iterations, gravity -9.81 on y, ...).
 struct kdw_engine_def kdw_engine_def_default(void);
 
@@ -346,6 +449,10 @@ kdw_status kdw_engine_get_stats(const struct kdw_engine *engine, struct kdw_engi
 
 // Puts every chain back to its rest shape, at rest, at the next step.
 kdw_status kdw_engine_reset(struct kdw_engine *engine);
+
+// Every chain treats its anchor's motion in the next step as a teleport (the engine's `teleport_mode`),
+// however small: call it when the character is placed somewhere new.
+kdw_status kdw_engine_teleport(struct kdw_engine *engine);
 
 // A hash of everything that determines future results. Equal hashes after equal calls show determinism;
 // an unchanged hash after a rejected call shows the engine was left untouched.

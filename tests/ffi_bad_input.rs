@@ -364,6 +364,8 @@ fn sentinel_engine_def() -> kdw_engine_def {
         time_scale: SENTINEL_F,
         teleport_distance: SENTINEL_F,
         teleport_angle: SENTINEL_F,
+        teleport_mode: SENTINEL_U32,
+        scale: SENTINEL_F,
     }
 }
 
@@ -377,6 +379,8 @@ fn sentinel_chain_def() -> kdw_chain_def {
         radius: SENTINEL_F,
         gravity_scale: SENTINEL_F,
         anchor: SENTINEL_U32,
+        collision_mask: SENTINEL_U32,
+        friction: SENTINEL_F,
     }
 }
 

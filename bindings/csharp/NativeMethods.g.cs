@@ -103,6 +103,71 @@ namespace Kodawari.Native
         internal static extern int kdw_chain_kinetic_energy(kdw_engine* engine, ulong chain, float* out_energy);
 
         /// <summary>
+        ///  Per-joint collision radii in character units (× the engine's `scale` m), each in [0, 1e6]: `count` must
+        ///  equal the chain's joint count, or be 0 to go back to the chain def's `radius` for every joint.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_chain_set_joint_radii", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_chain_set_joint_radii(kdw_engine* engine, ulong chain, float* radii, uint count);
+
+        /// <summary>
+        ///  The chain treats its anchor's motion in the next step as a teleport (the engine's `teleport_mode`).
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_chain_teleport", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_chain_teleport(kdw_engine* engine, ulong chain);
+
+        /// <summary>
+        ///  Default collider: a sphere of radius 0.1 m at the origin on layer 1.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_collider_def_default", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern kdw_collider_def kdw_collider_def_default();
+
+        /// <summary>
+        ///  Creates a collider. Chains whose `collision_mask` shares a bit with its `layers` are kept out of it (or
+        ///  inside it). `*out_collider` receives its id.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_collider_create", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_collider_create(kdw_engine* engine, kdw_collider_def* def, ulong* out_collider);
+
+        /// <summary>
+        ///  Destroys a collider. Later colliders keep their relative order in `kdw_engine_set_collider_transforms`.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_collider_destroy", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_collider_destroy(kdw_engine* engine, ulong collider);
+
+        /// <summary>
+        ///  `*out_valid` = 1 if `collider` names a live collider of this engine, else 0.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_collider_is_valid", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_collider_is_valid(kdw_engine* engine, ulong collider, uint* out_valid);
+
+        /// <summary>
+        ///  Moves a collider to other layers.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_collider_set_layers", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_collider_set_layers(kdw_engine* engine, ulong collider, uint layers);
+
+        /// <summary>
+        ///  Sets every collider's world pose for the next step: `count` must equal the collider count, entry i
+        ///  belongs to the i-th collider in creation order. The step sweeps each collider from its last pose to
+        ///  this one across its substeps (a jump beyond the teleport thresholds is not swept).
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_engine_set_collider_transforms", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_engine_set_collider_transforms(kdw_engine* engine, kdw_transform* transforms, uint count);
+
+        /// <summary>
+        ///  Number of colliders.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_engine_collider_count", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_engine_collider_count(kdw_engine* engine, uint* out_count);
+
+        /// <summary>
+        ///  Collider ids in creation order (the order of `kdw_engine_set_collider_transforms`). `capacity` must be
+        ///  at least the collider count.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_engine_get_collider_ids", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_engine_get_collider_ids(kdw_engine* engine, ulong* out_ids, uint capacity, uint* out_written);
+
+        /// <summary>
         ///  Default engine settings (240 Hz substeps, 2 iterations, gravity -9.81 on y, ...).
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_engine_def_default", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
@@ -211,6 +276,13 @@ namespace Kodawari.Native
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_engine_reset", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
         internal static extern int kdw_engine_reset(kdw_engine* engine);
+
+        /// <summary>
+        ///  Every chain treats its anchor's motion in the next step as a teleport (the engine's `teleport_mode`),
+        ///  however small: call it when the character is placed somewhere new.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_engine_teleport", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_engine_teleport(kdw_engine* engine);
 
         /// <summary>
         ///  A hash of everything that determines future results. Equal hashes after equal calls show determinism;
@@ -455,7 +527,7 @@ namespace Kodawari.Native
         /// </summary>
         public uint struct_size;
         /// <summary>
-        ///  World gravity, m/s², each component within ±1e6. Default (0, -9.81, 0).
+        ///  World gravity in character units/s² (× `scale` m/s²), each component within ±1e6. Default (0, -9.81, 0).
         /// </summary>
         public kdw_vec3 gravity;
         /// <summary>
@@ -476,7 +548,7 @@ namespace Kodawari.Native
         /// </summary>
         public float time_scale;
         /// <summary>
-        ///  An anchor moving farther than this (m) in one step is a teleport: the chain is carried rigidly.
+        ///  An anchor moving farther than this in one step is a teleport, in character units (× `scale` m).
         ///  &gt; 0; FLT_MAX disables. Default 1.
         /// </summary>
         public float teleport_distance;
@@ -485,6 +557,16 @@ namespace Kodawari.Native
         ///  Default pi/2.
         /// </summary>
         public float teleport_angle;
+        /// <summary>
+        ///  What a teleport does: `KDW_TELEPORT_CARRY_SHAPE` (default) or `KDW_TELEPORT_RESET`.
+        /// </summary>
+        public uint teleport_mode;
+        /// <summary>
+        ///  Size of the character relative to the units its parameters are tuned in, in [1e-6, 1e6]: multiplies
+        ///  gravity, `teleport_distance` and chain/joint radii, so a character scaled by 100 with scale 100 moves
+        ///  like the unscaled one. Transforms and collider sizes are world units. Default 1.
+        /// </summary>
+        public float scale;
     }
 
     /// <summary>
@@ -517,7 +599,9 @@ namespace Kodawari.Native
         /// </summary>
         public float mass;
         /// <summary>
-        ///  Particle radius, m, in [0, 1e6] (weight of orientations in shape matching). Default 0.02.
+        ///  Particle radius in character units (× the engine's `scale` m), in [0, 1e6]: every joint's collision
+        ///  radius unless `kdw_chain_set_joint_radii` set them, and the weight of orientations in shape matching.
+        ///  Default 0.02.
         /// </summary>
         public float radius;
         /// <summary>
@@ -528,6 +612,15 @@ namespace Kodawari.Native
         ///  `KDW_ANCHOR_VIEW_REFERENCE` (default) or `KDW_ANCHOR_OWN`.
         /// </summary>
         public uint anchor;
+        /// <summary>
+        ///  Collision layers the chain collides with (a collider whose `layers` share a bit). 0: no collisions,
+        ///  and no collision cost. Default 0xFFFFFFFF.
+        /// </summary>
+        public uint collision_mask;
+        /// <summary>
+        ///  Coulomb friction against colliders, in [0, 10]. Default 0.3.
+        /// </summary>
+        public float friction;
     }
 
     /// <summary>
@@ -550,7 +643,7 @@ namespace Kodawari.Native
         ///  Chains that cost nothing in the last step (sleeping or disabled).
         /// </summary>
         public uint chains_asleep;
-        public uint reserved;
+        public uint collider_count;
         public ulong substeps_total;
         /// <summary>
         ///  Internal steps where the direct inextensibility solve failed and a fallback ran.
@@ -564,6 +657,42 @@ namespace Kodawari.Native
         ///  Simulated seconds advanced in total.
         /// </summary>
         public double simulated_time;
+        /// <summary>
+        ///  (segment or particle, collider) pairs tested by the contact pass in total.
+        /// </summary>
+        public ulong contact_pairs_tested;
+    }
+
+    /// <summary>
+    ///  A collider; obtain defaults from `kdw_collider_def_default()`.
+    /// </summary>
+    [StructLayout(LayoutKind.Sequential)]
+    internal unsafe partial struct kdw_collider_def
+    {
+        /// <summary>
+        ///  `sizeof(kdw_collider_def)`.
+        /// </summary>
+        public uint struct_size;
+        /// <summary>
+        ///  One of `KDW_COLLIDER_*`. Default `KDW_COLLIDER_SPHERE`.
+        /// </summary>
+        public uint shape;
+        /// <summary>
+        ///  Sphere and capsule radius, m (world units), in [0, 1e6]; &gt; 0 for inside colliders. Default 0.1.
+        /// </summary>
+        public float radius;
+        /// <summary>
+        ///  Capsule half length of the axis, m, in [0, 1e6]. Default 0.
+        /// </summary>
+        public float half_height;
+        /// <summary>
+        ///  Initial world pose; `kdw_engine_set_collider_transforms` moves it every frame.
+        /// </summary>
+        public kdw_transform transform;
+        /// <summary>
+        ///  Layers the collider is on: it affects chains whose `collision_mask` shares a bit. Default 1.
+        /// </summary>
+        public uint layers;
     }
 
 
@@ -642,6 +771,16 @@ namespace Kodawari.Native
         internal const int KDW_STATUS_PANIC = -100;
 
         /// <summary>
+        /// A teleport moves the chain rigidly with its anchor, keeping its shape and adding no energy.
+        /// </summary>
+        internal const uint KDW_TELEPORT_CARRY_SHAPE = 0;
+
+        /// <summary>
+        /// A teleport puts the chain back to its rest shape under the new anchor, at rest.
+        /// </summary>
+        internal const uint KDW_TELEPORT_RESET = 1;
+
+        /// <summary>
         /// The chain's anchor is the view reference joint K given with each step.
         /// </summary>
         internal const uint KDW_ANCHOR_VIEW_REFERENCE = 0;
@@ -652,8 +791,34 @@ namespace Kodawari.Native
         internal const uint KDW_ANCHOR_OWN = 1;
 
         /// <summary>
+        /// Keeps particles outside a ball of `radius`.
+        /// </summary>
+        internal const uint KDW_COLLIDER_SPHERE = 0;
+
+        /// <summary>
+        /// Keeps particles outside a capsule: `radius` around the segment from -`half_height` to +`half_height`
+        /// on the collider's local Y axis.
+        /// </summary>
+        internal const uint KDW_COLLIDER_CAPSULE = 1;
+
+        /// <summary>
+        /// Keeps particles on the local +Y side of the plane through the collider's origin.
+        /// </summary>
+        internal const uint KDW_COLLIDER_PLANE = 2;
+
+        /// <summary>
+        /// Keeps particles inside a ball of `radius`.
+        /// </summary>
+        internal const uint KDW_COLLIDER_INSIDE_SPHERE = 3;
+
+        /// <summary>
+        /// Keeps particles inside a capsule.
+        /// </summary>
+        internal const uint KDW_COLLIDER_INSIDE_CAPSULE = 4;
+
+        /// <summary>
         /// Bumped on every incompatible change of the C ABI (signatures, struct layouts, semantics).
         /// </summary>
-        internal const uint KDW_ABI_VERSION = 1;
+        internal const uint KDW_ABI_VERSION = 2;
     }
 }

@@ -58,6 +58,10 @@ pub struct Chain {
     pub(crate) local_current: Vec<Transform>,
     /// Interpolated, skinning-ready pose in the anchor frame.
     pub(crate) output: Vec<Transform>,
+    /// Per-joint collision radii (character units); empty: every joint uses `params.radius`.
+    pub(crate) joint_radii: Vec<f32>,
+    /// An explicit teleport was asked for: the next step treats the anchor's motion as one.
+    pub(crate) teleport_requested: bool,
 }
 
 impl Chain {
@@ -91,6 +95,8 @@ impl Chain {
             local_previous: local.clone(),
             local_current: local.clone(),
             output: local,
+            joint_radii: Vec::new(),
+            teleport_requested: false,
         };
         chain.update_rest(None);
         chain.rest_used.clone_from(&chain.rest);
@@ -101,6 +107,21 @@ impl Chain {
 
     pub fn joint_count(&self) -> usize {
         self.rest.len()
+    }
+
+    /// Sum of the segment lengths: no particle is ever farther than this from the root.
+    pub(crate) fn reach(&self) -> f32 {
+        self.frame.lengths.iter().sum()
+    }
+
+    /// Collision radius of each joint in metres under `scale`, into `out`.
+    pub(crate) fn scaled_radii(&self, scale: f32, out: &mut Vec<f32>) {
+        out.clear();
+        if self.joint_radii.is_empty() {
+            out.resize(self.joint_count(), self.params.radius * scale);
+        } else {
+            out.extend(self.joint_radii.iter().map(|r| r * scale));
+        }
     }
 
     /// Validates and encodes a view shape for this chain (lengths and root come from the base).

@@ -8,9 +8,11 @@ use glam::{Quat, Vec3};
 
 use super::arena::{Arena, Id, Kind};
 use super::chain::{Chain, ViewShape, ViewShapeId, relative_rotation};
+use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderSweep};
+use super::collision::ContactInput;
 use super::error::{Error, Result};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
-use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE};
+use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, TeleportMode};
 use super::rod::{RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
 
@@ -32,6 +34,10 @@ pub struct Stats {
     pub time_dropped: f64,
     /// Simulated seconds advanced (after time scale), including the part not yet run as a substep.
     pub simulated_time: f64,
+    pub collider_count: u32,
+    /// (segment or particle, collider) pairs the contact pass tested, over all steps: 0 while no chain can
+    /// touch a collider.
+    pub contact_pairs_tested: u64,
 }
 
 /// Salts ids so that an id from one engine is rejected by another. Only distinguishes engines; it never
@@ -44,6 +50,9 @@ pub struct Engine {
     /// Chain slots in creation order: the order of every batched read and write.
     order: Vec<u32>,
     view_shapes: Arena<u32>,
+    colliders: Arena<Collider>,
+    /// Collider slots in creation order: the order of `set_collider_transforms`.
+    collider_order: Vec<u32>,
     accumulator: f64,
     /// World position the particle state is relative to: the view reference position of the last step,
     /// so a character far from the world origin keeps full float precision.
@@ -52,7 +61,20 @@ pub struct Engine {
     view: Option<Vec3>,
     joint_count: usize,
     scratch: RodScratch,
+    contact_scratch: ContactScratch,
     stats: Stats,
+}
+
+/// Buffers of the contact pass, reused across steps.
+#[derive(Default)]
+struct ContactScratch {
+    /// Every collider's sweep in every substep of the current step: `[substep * colliders + collider]`.
+    sweeps: Vec<ColliderSweep>,
+    /// Indices (in collider order) of the colliders the current chain can touch this step.
+    candidates: Vec<usize>,
+    /// Their sweeps in the current substep.
+    chain_sweeps: Vec<ColliderSweep>,
+    radii: Vec<f32>,
 }
 
 impl Engine {
@@ -64,12 +86,15 @@ impl Engine {
             chains: Arena::new(Kind::Chain, salt),
             order: Vec::new(),
             view_shapes: Arena::new(Kind::ViewShape, salt),
+            colliders: Arena::new(Kind::Collider, salt),
+            collider_order: Vec::new(),
             accumulator: 0.0,
             origin: Vec3::ZERO,
             view_reference: None,
             view: None,
             joint_count: 0,
             scratch: RodScratch::default(),
+            contact_scratch: ContactScratch::default(),
             stats: Stats::default(),
         })
     }
@@ -97,7 +122,12 @@ impl Engine {
     }
 
     pub fn stats(&self) -> Stats {
-        Stats { chain_count: self.order.len() as u32, joint_count: self.joint_count as u32, ..self.stats }
+        Stats {
+            chain_count: self.order.len() as u32,
+            joint_count: self.joint_count as u32,
+            collider_count: self.collider_order.len() as u32,
+            ..self.stats
+        }
     }
 
     // ---- chains -------------------------------------------------------------------------------------
@@ -202,6 +232,106 @@ impl Engine {
                 // Until its first step a new chain reads back in its rest shape under this anchor.
                 chain.anchor = anchor;
             }
+        }
+        Ok(())
+    }
+
+    /// Per-joint collision radii in character units (× `scale` m), one per joint, each in [0, 1e6]; an empty
+    /// slice goes back to `params.radius` for every joint.
+    pub fn set_chain_joint_radii(&mut self, id: ChainId, radii: &[f32]) -> Result<()> {
+        let chain = self.chain(id)?;
+        if !radii.is_empty() && radii.len() != chain.joint_count() {
+            return Err(Error::invalid_argument(format!(
+                "set_chain_joint_radii needs one radius per joint ({}) or none, got {}",
+                chain.joint_count(),
+                radii.len()
+            )));
+        }
+        if let Some((j, r)) = radii.iter().enumerate().find(|(_, r)| !(0.0..=MAX_RADIUS).contains(*r)) {
+            return Err(Error::invalid_argument(format!("joint radius {j} is {r}, outside [0, {MAX_RADIUS}]")));
+        }
+        let chain = self.chain_mut(id)?;
+        chain.joint_radii.clear();
+        chain.joint_radii.extend_from_slice(radii);
+        Ok(())
+    }
+
+    /// The next step treats the chain's anchor motion as a teleport (see [`TeleportMode`]), whatever its size.
+    pub fn teleport_chain(&mut self, id: ChainId) -> Result<()> {
+        self.chain_mut(id)?.teleport_requested = true;
+        Ok(())
+    }
+
+    /// [`teleport_chain`](Self::teleport_chain) for every chain: the character jumped.
+    pub fn teleport_all(&mut self) {
+        for &slot in &self.order {
+            if let Some(chain) = self.chains.at_mut(slot as usize) {
+                chain.teleport_requested = true;
+            }
+        }
+    }
+
+    // ---- colliders ----------------------------------------------------------------------------------
+
+    pub fn create_collider(&mut self, def: &ColliderDef) -> Result<ColliderId> {
+        def.validate()?;
+        let pose = validate_transform(&def.transform).map_err(|e| Error::invalid_argument(format!("collider: {e}")))?;
+        if !self.colliders.has_room() {
+            return Err(Error::capacity("the engine holds the maximum number of colliders"));
+        }
+        let id = self.colliders.insert(Collider::new(def, pose)).expect("room checked above");
+        self.collider_order.push(self.colliders.index_of(id).expect("just inserted") as u32);
+        Ok(Id::from_bits(id.to_bits()))
+    }
+
+    pub fn destroy_collider(&mut self, id: ColliderId) -> Result<()> {
+        let own = Id::from_bits(id.to_bits());
+        let index = self.colliders.index_of(own).ok_or_else(|| collider_not_found(id))?;
+        self.colliders.remove(own);
+        self.collider_order.retain(|&slot| slot as usize != index);
+        Ok(())
+    }
+
+    pub fn is_collider_valid(&self, id: ColliderId) -> bool {
+        self.colliders.get(Id::from_bits(id.to_bits())).is_some()
+    }
+
+    pub fn collider_count(&self) -> usize {
+        self.collider_order.len()
+    }
+
+    /// Collider ids in creation order (the order of [`set_collider_transforms`](Self::set_collider_transforms)).
+    pub fn collider_ids(&self) -> impl Iterator<Item = ColliderId> + '_ {
+        self.collider_order
+            .iter()
+            .map(|&slot| Id::from_bits(self.colliders.id_at(slot as usize).expect("live").to_bits()))
+    }
+
+    /// Changes a collider's layers.
+    pub fn set_collider_layers(&mut self, id: ColliderId, layers: u32) -> Result<()> {
+        self.colliders.get_mut(Id::from_bits(id.to_bits())).ok_or_else(|| collider_not_found(id))?.layers = layers;
+        Ok(())
+    }
+
+    /// World poses of every collider for the next step, in creation order. The step moves each collider
+    /// from its last pose to this one across its substeps; a jump beyond the teleport thresholds is not swept.
+    pub fn set_collider_transforms<I>(&mut self, transforms: I) -> Result<()>
+    where
+        I: ExactSizeIterator<Item = Transform> + Clone,
+    {
+        if transforms.len() != self.collider_order.len() {
+            return Err(Error::invalid_argument(format!(
+                "set_collider_transforms needs one transform per collider ({}), got {}",
+                self.collider_order.len(),
+                transforms.len()
+            )));
+        }
+        for (i, t) in transforms.clone().enumerate() {
+            validate_transform(&t).map_err(|e| Error::invalid_argument(format!("collider transform {i}: {e}")))?;
+        }
+        for (&slot, t) in self.collider_order.iter().zip(transforms) {
+            let collider = self.colliders.at_mut(slot as usize).expect("order holds live colliders");
+            collider.pending = validate_transform(&t).expect("validated above");
         }
         Ok(())
     }
@@ -343,7 +473,13 @@ impl Engine {
             if span > 0.0 { (((s + 1) as f64 * h - before) / span).clamp(0.0, 1.0) as f32 } else { 1.0 }
         };
 
+        let progress_at_start = |s: u64| if s == 0 { 0.0 } else { progress(s - 1) };
+        self.sweep_colliders(substeps, origin, progress_at_start, progress);
+        let collider_count = self.collider_order.len();
+        let teleport_distance = settings.teleport_distance * settings.scale;
+
         let mut fallbacks = 0u64;
+        let mut contact_pairs = 0u64;
         for &slot in &self.order {
             let chain = self.chains.at_mut(slot as usize).expect("live");
             let anchor_world = match chain.params.anchor {
@@ -354,15 +490,40 @@ impl Engine {
             let target = to_relative(&anchor_world);
             let mut start = to_relative(&chain.anchor);
             chain.update_rest(self.view);
-            if !chain.placed {
+            let teleport = std::mem::take(&mut chain.teleport_requested)
+                || is_teleport(&start, &target, teleport_distance, settings.teleport_angle);
+            if !chain.placed || (teleport && settings.teleport_mode == TeleportMode::Reset) {
                 chain.place(&target);
                 start = target;
-            } else if is_teleport(&start, &target, &settings) {
+            } else if teleport {
                 // Carry the chain rigidly: keeps its shape, adds no energy, no whip.
                 chain.state.carry(&target.mul(&start.inverse()));
                 start = target;
             }
             chain.anchor = anchor_world;
+
+            // The colliders this chain can touch during this step: on a layer of its mask and close enough.
+            let contacts = &mut self.contact_scratch;
+            contacts.candidates.clear();
+            if chain.params.collision_mask != 0 && collider_count > 0 && substeps > 0 {
+                chain.scaled_radii(settings.scale, &mut contacts.radii);
+                let thickest = contacts.radii.iter().copied().fold(0.0, f32::max);
+                let reach = chain.rest.positions[0].length() + chain.reach() + thickest;
+                let chain_bound = Bound::of_motion(start.position, target.position, reach);
+                for (c, &collider_slot) in self.collider_order.iter().enumerate() {
+                    let collider = self.colliders.at(collider_slot as usize).expect("live");
+                    let first = &contacts.sweeps[c];
+                    let last = &contacts.sweeps[(substeps as usize - 1) * collider_count + c];
+                    let bound = Bound::of_motion(
+                        first.start.centre.as_vec3(),
+                        last.end.centre.as_vec3(),
+                        collider.shape.bounding_radius(),
+                    );
+                    if chain.params.collision_mask & collider.layers != 0 && chain_bound.touches(&bound) {
+                        contacts.candidates.push(c);
+                    }
+                }
+            }
 
             let params = chain.params;
             let alpha = params.alpha_per_iteration(h as f32, settings.iterations);
@@ -384,21 +545,33 @@ impl Engine {
                     chain.rest_used.clone_from(&chain.rest);
                     chain.rest_changed = false;
                 }
+                let contacts = &mut self.contact_scratch;
+                let touching = !contacts.candidates.is_empty();
+                if touching {
+                    let row = &contacts.sweeps[s as usize * collider_count..][..collider_count];
+                    contacts.chain_sweeps.clear();
+                    contacts.chain_sweeps.extend(contacts.candidates.iter().map(|&c| row[c]));
+                }
                 let input = SubstepInput {
                     h: h as f32,
                     anchor,
-                    gravity: settings.gravity * params.gravity_scale,
+                    gravity: settings.gravity * (params.gravity_scale * settings.scale),
                     velocity_decay: decay,
                     alpha_per_iteration: alpha,
                     iterations: settings.iterations,
                     inv_mass: 1.0 / params.mass,
-                    orientation_weight: params.radius * params.radius / 5.0,
+                    orientation_weight: (params.radius * settings.scale).powi(2) / 5.0,
                     rest: &chain.rest,
                     half_kick: chain.half_kick,
+                    contacts: touching.then(|| ContactInput {
+                        colliders: &contacts.chain_sweeps,
+                        radii: &contacts.radii,
+                        friction: params.friction,
+                    }),
                 };
-                if !substep(&mut chain.state, &chain.frame.lengths, &input, &mut self.scratch) {
-                    fallbacks += 1;
-                }
+                let report = substep(&mut chain.state, &chain.frame.lengths, &input, &mut self.scratch);
+                fallbacks += report.fallback as u64;
+                contact_pairs += report.contact_pairs;
                 chain.half_kick = false;
                 if s + 2 >= substeps {
                     chain.capture_local(&anchor);
@@ -406,12 +579,53 @@ impl Engine {
             }
             chain.write_output((after / h) as f32);
         }
+        if substeps > 0 {
+            for &slot in &self.collider_order {
+                let collider = self.colliders.at_mut(slot as usize).expect("live");
+                collider.previous = collider.current;
+            }
+        }
         self.accumulator = after;
+        self.stats.contact_pairs_tested += contact_pairs;
         self.stats.substeps_last_step = substeps as u32;
         self.stats.substeps_total += substeps;
         self.stats.solver_fallbacks += fallbacks;
         self.stats.time_dropped += dropped;
         self.stats.simulated_time += simulated;
+    }
+
+    /// Moves every collider to the pose set for this step and records its pose at the start and end of
+    /// each substep (relative to the engine origin). A collider that jumped beyond the teleport thresholds
+    /// is not swept: it appears at its new pose.
+    fn sweep_colliders(
+        &mut self,
+        substeps: u64,
+        origin: Vec3,
+        at_start: impl Fn(u64) -> f32,
+        at_end: impl Fn(u64) -> f32,
+    ) {
+        let settings = self.settings;
+        let sweeps = &mut self.contact_scratch.sweeps;
+        sweeps.clear();
+        for &slot in &self.collider_order {
+            let collider = self.colliders.at_mut(slot as usize).expect("live");
+            collider.current = collider.pending;
+            if is_teleport(
+                &collider.previous,
+                &collider.current,
+                settings.teleport_distance * settings.scale,
+                settings.teleport_angle,
+            ) {
+                collider.previous = collider.current;
+            }
+        }
+        for s in 0..substeps {
+            for &slot in &self.collider_order {
+                let collider = self.colliders.at(slot as usize).expect("live");
+                let pose = |t: f32| ColliderPose::new(&collider.previous.interpolate(&collider.current, t), origin);
+                sweeps.push(ColliderSweep { shape: collider.shape, start: pose(at_start(s)), end: pose(at_end(s)) });
+            }
+        }
     }
 
     // ---- reading ------------------------------------------------------------------------------------
@@ -490,6 +704,15 @@ impl Engine {
         Ok(())
     }
 
+    /// Calls `f` with the world position of each particle of one chain in the latest internal state (not
+    /// interpolated for rendering): what the solver and the contact pass see.
+    pub fn for_each_chain_particle(&self, id: ChainId, mut f: impl FnMut(Vec3)) -> Result<()> {
+        let chain = self.chain(id)?;
+        let origin = self.origin.as_dvec3();
+        chain.state.x.iter().for_each(|x| f((*x + origin).as_vec3()));
+        Ok(())
+    }
+
     /// World transforms of one chain's joints into `out`; returns how many were written.
     pub fn read_chain_world(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
         fill_slice(out, |capacity, f| self.for_each_chain_world_transform(id, capacity, f))
@@ -537,19 +760,49 @@ impl Engine {
         let mut hasher = std::collections::hash_map::DefaultHasher::new();
         let mut f = |x: f32| x.to_bits().hash(&mut hasher);
         let s = &self.settings;
-        for x in
-            [s.gravity.x, s.gravity.y, s.gravity.z, s.substep_rate, s.time_scale, s.teleport_distance, s.teleport_angle]
-        {
+        for x in [
+            s.gravity.x,
+            s.gravity.y,
+            s.gravity.z,
+            s.substep_rate,
+            s.time_scale,
+            s.teleport_distance,
+            s.teleport_angle,
+            s.scale,
+        ] {
             f(x);
         }
         for x in [self.origin.x, self.origin.y, self.origin.z] {
             f(x);
         }
-        let mut words: Vec<u64> =
-            vec![self.accumulator.to_bits(), s.max_substeps as u64, s.iterations as u64, self.order.len() as u64];
+        let mut words: Vec<u64> = vec![
+            self.accumulator.to_bits(),
+            s.max_substeps as u64,
+            s.iterations as u64,
+            s.teleport_mode as u64,
+            self.order.len() as u64,
+            self.collider_order.len() as u64,
+        ];
+        for &slot in &self.collider_order {
+            let collider = self.colliders.at(slot as usize).expect("live");
+            let (radius, half_height) = collider.shape.capsule().unwrap_or((-1.0, -1.0));
+            words.extend([collider.kind_code(), collider.layers as u64]);
+            words.extend([radius, half_height].map(|x| x.to_bits() as u64));
+            for t in [&collider.previous, &collider.current, &collider.pending] {
+                words
+                    .extend(t.position.to_array().into_iter().chain(t.rotation.to_array()).map(|x| x.to_bits() as u64));
+            }
+        }
         for chain in self.chains_in_order() {
             let p = &chain.params;
-            words.push(chain.placed as u64 | (chain.half_kick as u64) << 1 | (chain.rest_changed as u64) << 2);
+            words.push(
+                chain.placed as u64
+                    | (chain.half_kick as u64) << 1
+                    | (chain.rest_changed as u64) << 2
+                    | (chain.teleport_requested as u64) << 3,
+            );
+            words.push(p.collision_mask as u64);
+            words.extend(chain.joint_radii.iter().chain([&p.friction]).map(|x| x.to_bits() as u64));
             words.push(chain.views.len() as u64);
             for view in &chain.views {
                 words.extend(
@@ -618,9 +871,29 @@ fn check_chain_capacity(chain: &Chain, capacity: usize) -> Result<()> {
     Ok(())
 }
 
-fn is_teleport(from: &Transform, to: &Transform, settings: &EngineSettings) -> bool {
-    (to.position - from.position).length() > settings.teleport_distance
-        || rotation_angle(from.rotation.inverse() * to.rotation) > settings.teleport_angle
+fn is_teleport(from: &Transform, to: &Transform, distance: f32, angle: f32) -> bool {
+    (to.position - from.position).length() > distance || rotation_angle(from.rotation.inverse() * to.rotation) > angle
+}
+
+/// A sphere holding everything an object may reach during one step.
+struct Bound {
+    centre: Vec3,
+    radius: f32,
+}
+
+impl Bound {
+    /// Of an object reaching `reach` around a point that moves from `from` to `to`.
+    fn of_motion(from: Vec3, to: Vec3, reach: f32) -> Self {
+        Self { centre: (from + to) * 0.5, radius: (to - from).length() * 0.5 + reach }
+    }
+
+    fn touches(&self, other: &Bound) -> bool {
+        (self.centre - other.centre).length() <= self.radius + other.radius
+    }
+}
+
+fn collider_not_found(id: ColliderId) -> Error {
+    Error::invalid_id(format!("collider id {:#x} is null, stale or foreign", id.to_bits()))
 }
 
 /// Finite and within the coordinate range the solver can subtract and square without overflow.

@@ -5,12 +5,15 @@
 //! - [`weights`]: view direction and blend weights (3.2)
 //! - [`blend`]: blending encoded shapes (3.3)
 //! - [`polar`], [`rod`], [`inextensible`]: the oriented-particle rod and its constraints (3.4)
+//! - [`collider`], [`collision`]: colliders and the contact pass (3.7)
 //! - [`params`]: settings, parameters, units
 //! - [`arena`], [`chain`], [`engine`]: objects, ids and the stepping loop (3.5, 3.6, 3.9)
 
 pub mod arena;
 pub mod blend;
 pub mod chain;
+pub mod collider;
+pub mod collision;
 pub mod engine;
 pub mod error;
 pub mod inextensible;
@@ -23,7 +26,8 @@ pub mod sketch;
 pub mod weights;
 
 pub use chain::ViewShapeId;
+pub use collider::{ColliderDef, ColliderId, ColliderShape};
 pub use engine::{ChainId, Engine, Stats};
 pub use error::{Error, ErrorKind, Result};
 pub use math::Transform;
-pub use params::{AnchorSource, ChainParams, EngineSettings};
+pub use params::{AnchorSource, ChainParams, EngineSettings, TeleportMode};

@@ -13,10 +13,21 @@ pub enum AnchorSource {
     Own,
 }
 
+/// What happens to a chain whose anchor teleports (jumps farther or turns more than the engine's thresholds
+/// in one step, or is told to with an explicit teleport call).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TeleportMode {
+    /// Move the chain rigidly with its anchor: it keeps its current shape and its motion relative to the
+    /// anchor, and gains no energy from the jump.
+    CarryShape,
+    /// Put the chain back to its rest shape under the new anchor, at rest.
+    Reset,
+}
+
 /// Engine-wide settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EngineSettings {
-    /// World gravity, m/s², each component within ±1e6.
+    /// World gravity in character units per s² (× `scale` m/s²), each component within ±1e6.
     pub gravity: Vec3,
     /// Internal fixed steps per simulated second, Hz. Range [30, 10000].
     pub substep_rate: f32,
@@ -26,10 +37,18 @@ pub struct EngineSettings {
     pub iterations: u32,
     /// Simulated seconds per real second; 0 pauses. Range [0, 100].
     pub time_scale: f32,
-    /// An anchor moving farther than this in one call (m) is a teleport. > 0; `f32::MAX` disables.
+    /// An anchor moving farther than this in one call is a teleport, in character units (× `scale` m).
+    /// > 0; `f32::MAX` disables.
     pub teleport_distance: f32,
     /// An anchor turning more than this in one call (radians) is a teleport. > 0; above pi disables.
     pub teleport_angle: f32,
+    /// What a teleport does to a chain.
+    pub teleport_mode: TeleportMode,
+    /// Size of the character relative to the units its parameters are tuned in, dimensionless, in
+    /// [1e-6, 1e6]. Multiplies every length-valued parameter: gravity, `teleport_distance`, chain and joint
+    /// radii. A character scaled by 100 with `scale` 100 moves exactly like the unscaled one, 100 times
+    /// larger. Transforms, joint positions and collider sizes are world units and are not scaled.
+    pub scale: f32,
 }
 
 impl Default for EngineSettings {
@@ -42,6 +61,8 @@ impl Default for EngineSettings {
             time_scale: 1.0,
             teleport_distance: 1.0,
             teleport_angle: std::f32::consts::FRAC_PI_2,
+            teleport_mode: TeleportMode::CarryShape,
+            scale: 1.0,
         }
     }
 }
@@ -69,6 +90,9 @@ impl EngineSettings {
         check(self.teleport_angle > 0.0 && self.teleport_angle.is_finite(), || {
             format!("teleport_angle {} must be finite and > 0", self.teleport_angle)
         })?;
+        check((MIN_SCALE..=MAX_SCALE).contains(&self.scale), || {
+            format!("scale {} outside [{MIN_SCALE}, {MAX_SCALE}]", self.scale)
+        })?;
         Ok(())
     }
 
@@ -91,11 +115,18 @@ pub struct ChainParams {
     pub momentum_suppression: f32,
     /// Mass of each particle, kg, in [1e-6, 1e6]. (Uniform masses: only matters once forces other than gravity act.)
     pub mass: f32,
-    /// Particle radius, m, in [0, 1e6]: weight of orientations in shape matching, later the collision radius.
+    /// Particle radius in character units (× the engine's `scale` m), in [0, 1e6]: the collision radius of
+    /// every joint (unless per-joint radii are set) and the weight of orientations in shape matching.
     pub radius: f32,
     /// Multiplier on the engine's gravity, dimensionless. Range [-100, 100].
     pub gravity_scale: f32,
     pub anchor: AnchorSource,
+    /// Collision layers this chain collides with: a collider affects it when `collision_mask & layers` is
+    /// non-zero. 0 turns collisions off for the chain (it then runs no collision code). Default: all.
+    pub collision_mask: u32,
+    /// Coulomb friction coefficient against colliders, dimensionless, in [0, 10]: a particle pressed onto a
+    /// collider does not slide while the tangential pull is below `friction` times the normal one.
+    pub friction: f32,
 }
 
 /// Ranges that keep every product in the solver (radius², 1/mass, g·h², mass·v²) far from float32
@@ -104,6 +135,10 @@ pub const MAX_GRAVITY: f32 = 1e6;
 pub const MIN_MASS: f32 = 1e-6;
 pub const MAX_MASS: f32 = 1e6;
 pub const MAX_RADIUS: f32 = 1e6;
+pub const MAX_FRICTION: f32 = 10.0;
+/// Range of the engine's `scale`: characters from micrometre to kilometre size relative to their tuning.
+pub const MIN_SCALE: f32 = 1e-6;
+pub const MAX_SCALE: f32 = 1e6;
 /// Largest accepted coordinate of any position (m). Beyond it float32 resolves less than 60 m anyway.
 pub const MAX_COORDINATE: f32 = 1e9;
 
@@ -121,6 +156,8 @@ impl Default for ChainParams {
             radius: 0.02,
             gravity_scale: 1.0,
             anchor: AnchorSource::ViewReference,
+            collision_mask: u32::MAX,
+            friction: 0.3,
         }
     }
 }
@@ -140,6 +177,9 @@ impl ChainParams {
         })?;
         check((-100.0..=100.0).contains(&self.gravity_scale), || {
             format!("gravity_scale {} outside [-100, 100]", self.gravity_scale)
+        })?;
+        check((0.0..=MAX_FRICTION).contains(&self.friction), || {
+            format!("friction {} outside [0, {MAX_FRICTION}]", self.friction)
         })?;
         Ok(())
     }

@@ -4,6 +4,7 @@
 
 use glam::{DVec3, Mat3, Quat, Vec3};
 
+use super::collision::{ContactInput, collide};
 use super::inextensible::{self, ConstraintScratch};
 use super::math::{Transform, align_hemisphere, nlerp_shorter};
 use super::polar::extract_rotation;
@@ -12,6 +13,11 @@ use super::shape::Shape;
 /// Warm-started rotation extraction gains about 3x per iteration and starts from last substep's answer,
 /// so a few iterations reach float precision; it stops early once converged.
 const POLAR_ITERATIONS: u32 = 8;
+
+/// Most rounds of (lengths, contacts) in the last solver iteration; they stop once the contacts move
+/// nothing by more than `CONTACT_SETTLED` of the shortest segment.
+const FINAL_CONTACT_ROUNDS: u32 = 16;
+const CONTACT_SETTLED: f32 = 1e-4;
 
 /// The dynamic state of a chain's particles, relative to the engine's origin. Particle 0 is kinematic.
 ///
@@ -97,6 +103,17 @@ pub struct SubstepInput<'a> {
     pub rest: &'a Shape,
     /// First substep after placement: a half gravity kick starts the leapfrog.
     pub half_kick: bool,
+    /// The colliders this chain can touch during this substep; `None` runs no collision code.
+    pub contacts: Option<ContactInput<'a>>,
+}
+
+/// What a substep reports back for the engine's counters.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SubstepReport {
+    /// The inextensibility solve had to fall back in some iteration.
+    pub fallback: bool,
+    /// (segment or particle, collider) pairs tested.
+    pub contact_pairs: u64,
 }
 
 /// Per-particle buffers reused across chains and substeps.
@@ -120,8 +137,13 @@ impl RodScratch {
     }
 }
 
-/// Advances one chain by one substep. Returns `false` if the inextensibility solve had to fall back.
-pub fn substep(state: &mut RodState, lengths: &[f32], input: &SubstepInput<'_>, scratch: &mut RodScratch) -> bool {
+/// Advances one chain by one substep.
+pub fn substep(
+    state: &mut RodState,
+    lengths: &[f32],
+    input: &SubstepInput<'_>,
+    scratch: &mut RodScratch,
+) -> SubstepReport {
     let n = state.x.len();
     scratch.reserve(n);
     let h = input.h;
@@ -146,12 +168,29 @@ pub fn substep(state: &mut RodState, lengths: &[f32], input: &SubstepInput<'_>, 
 
     let alpha = input.alpha_per_iteration;
     let iterations = if alpha > 0.0 { input.iterations.max(1) } else { 1 };
-    let mut direct = true;
-    for _ in 0..iterations {
+    let mut report = SubstepReport::default();
+    for iteration in 0..iterations {
         if alpha > 0.0 {
             match_shape(&mut state.group_rotation, p, qp, input.rest, input.orientation_weight, alpha);
         }
-        direct &= inextensible::solve(&state.x, p, lengths, input.inv_mass, constraints);
+        report.fallback |= !inextensible::solve(&state.x, p, lengths, input.inv_mass, constraints);
+        if let Some(contacts) = &input.contacts {
+            let mut pass = collide(&state.x, p, contacts);
+            report.contact_pairs += pass.tested;
+            // A collider pushing hard (a swinging arm) moves a few particles far in one substep; the rest of
+            // the chain follows through more rounds of lengths then contacts. The substep ends on contacts.
+            if iteration + 1 == iterations {
+                let settled = CONTACT_SETTLED * lengths.iter().copied().fold(f32::INFINITY, f32::min);
+                for _ in 1..FINAL_CONTACT_ROUNDS {
+                    if !pass.touching || pass.deepest <= settled {
+                        break;
+                    }
+                    report.fallback |= !inextensible::solve(&state.x, p, lengths, input.inv_mass, constraints);
+                    pass = collide(&state.x, p, contacts);
+                    report.contact_pairs += pass.tested;
+                }
+            }
+        }
     }
 
     // Velocities from positions.
@@ -164,7 +203,7 @@ pub fn substep(state: &mut RodState, lengths: &[f32], input: &SubstepInput<'_>, 
     }
     state.x[0] = p[0];
     state.q[0] = qp[0];
-    direct
+    report
 }
 
 /// Momentum suppression (SPEC 3.6): the rest shape changed from `old` to `new` since the last substep.

@@ -162,3 +162,27 @@ pub extern "C" fn kdw_chain_kinetic_energy(
 ) -> kdw_status {
     query(engine, out_energy, "out_energy", |e| Ok(e.chain_kinetic_energy(ChainId::from_bits(chain))?))
 }
+
+/// Per-joint collision radii in character units (× the engine's `scale` m), each in [0, 1e6]: `count` must
+/// equal the chain's joint count, or be 0 to go back to the chain def's `radius` for every joint.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_chain_set_joint_radii(
+    engine: *mut kdw_engine,
+    chain: kdw_chain_id,
+    radii: *const f32,
+    count: u32,
+) -> kdw_status {
+    guard(|| {
+        // SAFETY: the caller passes `count` readable floats (NULL is accepted when count is 0).
+        let radii = if count == 0 { &[][..] } else { unsafe { slice(radii, count, "radii") }? };
+        // SAFETY: live engine handle, this thread only.
+        unsafe { with_engine_mut(engine, |e| Ok(e.set_chain_joint_radii(ChainId::from_bits(chain), radii)?)) }
+    })
+}
+
+/// The chain treats its anchor's motion in the next step as a teleport (the engine's `teleport_mode`).
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_chain_teleport(engine: *mut kdw_engine, chain: kdw_chain_id) -> kdw_status {
+    // SAFETY: live engine handle, this thread only.
+    guard(|| unsafe { with_engine_mut(engine, |e| Ok(e.teleport_chain(ChainId::from_bits(chain))?)) })
+}

@@ -27,7 +27,7 @@ pub extern "C" fn kdw_engine_create(def: *const kdw_engine_def, out_engine: *mut
         // SAFETY: the caller passes a readable kdw_engine_def (NULL and alignment are checked).
         let def = unsafe { read(def, "def") }?;
         check_struct_size::<kdw_engine_def>(def.struct_size, "kdw_engine_def")?;
-        let engine = Engine::new(def.into())?;
+        let engine = Engine::new(EngineSettings::try_from(def)?)?;
         // SAFETY: checked by check_out; the caller provides a writable pointer slot.
         unsafe { write(out_engine, into_handle(engine)) };
         Ok(())
@@ -58,8 +58,9 @@ pub extern "C" fn kdw_engine_set_def(engine: *mut kdw_engine, def: *const kdw_en
         // SAFETY: the caller passes a readable kdw_engine_def.
         let def = unsafe { read(def, "def") }?;
         check_struct_size::<kdw_engine_def>(def.struct_size, "kdw_engine_def")?;
+        let settings = EngineSettings::try_from(def)?;
         // SAFETY: `engine` is a live engine handle used by this thread only.
-        unsafe { with_engine_mut(engine, |e| Ok(e.set_settings(def.into())?)) }
+        unsafe { with_engine_mut(engine, |e| Ok(e.set_settings(settings)?)) }
     })
 }
 
@@ -232,6 +233,19 @@ pub extern "C" fn kdw_engine_reset(engine: *mut kdw_engine) -> kdw_status {
     guard(|| unsafe {
         with_engine_mut(engine, |e| {
             e.reset_all();
+            Ok(())
+        })
+    })
+}
+
+/// Every chain treats its anchor's motion in the next step as a teleport (the engine's `teleport_mode`),
+/// however small: call it when the character is placed somewhere new.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_teleport(engine: *mut kdw_engine) -> kdw_status {
+    // SAFETY: live engine handle, this thread only.
+    guard(|| unsafe {
+        with_engine_mut(engine, |e| {
+            e.teleport_all();
             Ok(())
         })
     })

@@ -3,7 +3,7 @@
 //! - [`types`]: plain C structs (vectors, transforms, ids) and their conversions to core types
 //! - [`status`]: `kdw_status`, its strings, the thread-local error message
 //! - [`guard`]: the panic guard and the pointer checks every exported body goes through
-//! - one module per C concept: [`engine`], [`chain`], [`view_shape`], [`version`]
+//! - one module per C concept: [`engine`], [`chain`], [`collider`], [`view_shape`], [`version`]
 
 #![allow(non_camel_case_types)]
 // C names, exactly as in the header.
@@ -13,6 +13,7 @@
 #![allow(clippy::not_unsafe_ptr_arg_deref)]
 
 pub mod chain;
+pub mod collider;
 pub mod engine;
 pub mod guard;
 pub mod sketch;

@@ -3,7 +3,9 @@
 
 use glam::{Quat, Vec3};
 
-use crate::core::{AnchorSource, ChainParams, EngineSettings, Stats, Transform};
+use crate::core::{
+    AnchorSource, ChainParams, ColliderDef, ColliderShape, EngineSettings, Stats, TeleportMode, Transform,
+};
 
 /// A 3D vector, the layout of Unity's `Vector3`.
 #[repr(C)]
@@ -39,6 +41,14 @@ pub type kdw_chain_id = u64;
 /// A view shape of a chain. 0 is the null id.
 pub type kdw_view_shape_id = u64;
 
+/// A collider. 0 is the null id.
+pub type kdw_collider_id = u64;
+
+/// A teleport moves the chain rigidly with its anchor, keeping its shape and adding no energy.
+pub const KDW_TELEPORT_CARRY_SHAPE: u32 = 0;
+/// A teleport puts the chain back to its rest shape under the new anchor, at rest.
+pub const KDW_TELEPORT_RESET: u32 = 1;
+
 /// The chain's anchor is the view reference joint K given with each step.
 pub const KDW_ANCHOR_VIEW_REFERENCE: u32 = 0;
 /// The chain's anchor is its own entry in `kdw_engine_set_anchors`.
@@ -50,7 +60,7 @@ pub const KDW_ANCHOR_OWN: u32 = 1;
 pub struct kdw_engine_def {
     /// `sizeof(kdw_engine_def)`; lets the struct grow without breaking old callers.
     pub struct_size: u32,
-    /// World gravity, m/s², each component within ±1e6. Default (0, -9.81, 0).
+    /// World gravity in character units/s² (× `scale` m/s²), each component within ±1e6. Default (0, -9.81, 0).
     pub gravity: kdw_vec3,
     /// Internal fixed steps per simulated second, Hz, in [30, 10000]. Default 240.
     pub substep_rate: f32,
@@ -61,12 +71,18 @@ pub struct kdw_engine_def {
     pub iterations: u32,
     /// Simulated seconds per second of `dt`, in [0, 100]; 0 pauses. Default 1.
     pub time_scale: f32,
-    /// An anchor moving farther than this (m) in one step is a teleport: the chain is carried rigidly.
+    /// An anchor moving farther than this in one step is a teleport, in character units (× `scale` m).
     /// > 0; FLT_MAX disables. Default 1.
     pub teleport_distance: f32,
     /// An anchor turning more than this (radians) in one step is a teleport. > 0; above pi disables.
     /// Default pi/2.
     pub teleport_angle: f32,
+    /// What a teleport does: `KDW_TELEPORT_CARRY_SHAPE` (default) or `KDW_TELEPORT_RESET`.
+    pub teleport_mode: u32,
+    /// Size of the character relative to the units its parameters are tuned in, in [1e-6, 1e6]: multiplies
+    /// gravity, `teleport_distance` and chain/joint radii, so a character scaled by 100 with scale 100 moves
+    /// like the unscaled one. Transforms and collider sizes are world units. Default 1.
+    pub scale: f32,
 }
 
 /// Chain parameters; obtain defaults from `kdw_chain_def_default()`.
@@ -86,12 +102,19 @@ pub struct kdw_chain_def {
     pub momentum_suppression: f32,
     /// Mass per particle, kg, in [1e-6, 1e6]. Default 1.
     pub mass: f32,
-    /// Particle radius, m, in [0, 1e6] (weight of orientations in shape matching). Default 0.02.
+    /// Particle radius in character units (× the engine's `scale` m), in [0, 1e6]: every joint's collision
+    /// radius unless `kdw_chain_set_joint_radii` set them, and the weight of orientations in shape matching.
+    /// Default 0.02.
     pub radius: f32,
     /// Multiplier on the engine's gravity, in [-100, 100]. Default 1.
     pub gravity_scale: f32,
     /// `KDW_ANCHOR_VIEW_REFERENCE` (default) or `KDW_ANCHOR_OWN`.
     pub anchor: u32,
+    /// Collision layers the chain collides with (a collider whose `layers` share a bit). 0: no collisions,
+    /// and no collision cost. Default 0xFFFFFFFF.
+    pub collision_mask: u32,
+    /// Coulomb friction against colliders, in [0, 10]. Default 0.3.
+    pub friction: f32,
 }
 
 /// Counters for profiling overlays.
@@ -106,7 +129,7 @@ pub struct kdw_engine_stats {
     pub substeps_last_step: u32,
     /// Chains that cost nothing in the last step (sleeping or disabled).
     pub chains_asleep: u32,
-    pub reserved: u32,
+    pub collider_count: u32,
     pub substeps_total: u64,
     /// Internal steps where the direct inextensibility solve failed and a fallback ran.
     pub solver_fallbacks: u64,
@@ -114,6 +137,74 @@ pub struct kdw_engine_stats {
     pub time_dropped: f64,
     /// Simulated seconds advanced in total.
     pub simulated_time: f64,
+    /// (segment or particle, collider) pairs tested by the contact pass in total.
+    pub contact_pairs_tested: u64,
+}
+
+/// Keeps particles outside a ball of `radius`.
+pub const KDW_COLLIDER_SPHERE: u32 = 0;
+/// Keeps particles outside a capsule: `radius` around the segment from -`half_height` to +`half_height`
+/// on the collider's local Y axis.
+pub const KDW_COLLIDER_CAPSULE: u32 = 1;
+/// Keeps particles on the local +Y side of the plane through the collider's origin.
+pub const KDW_COLLIDER_PLANE: u32 = 2;
+/// Keeps particles inside a ball of `radius`.
+pub const KDW_COLLIDER_INSIDE_SPHERE: u32 = 3;
+/// Keeps particles inside a capsule.
+pub const KDW_COLLIDER_INSIDE_CAPSULE: u32 = 4;
+
+/// A collider; obtain defaults from `kdw_collider_def_default()`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct kdw_collider_def {
+    /// `sizeof(kdw_collider_def)`.
+    pub struct_size: u32,
+    /// One of `KDW_COLLIDER_*`. Default `KDW_COLLIDER_SPHERE`.
+    pub shape: u32,
+    /// Sphere and capsule radius, m (world units), in [0, 1e6]; > 0 for inside colliders. Default 0.1.
+    pub radius: f32,
+    /// Capsule half length of the axis, m, in [0, 1e6]. Default 0.
+    pub half_height: f32,
+    /// Initial world pose; `kdw_engine_set_collider_transforms` moves it every frame.
+    pub transform: kdw_transform,
+    /// Layers the collider is on: it affects chains whose `collision_mask` shares a bit. Default 1.
+    pub layers: u32,
+}
+
+impl From<ColliderDef> for kdw_collider_def {
+    fn from(d: ColliderDef) -> Self {
+        let (shape, radius, half_height) = match d.shape {
+            ColliderShape::Sphere { radius } => (KDW_COLLIDER_SPHERE, radius, 0.0),
+            ColliderShape::Capsule { radius, half_height } => (KDW_COLLIDER_CAPSULE, radius, half_height),
+            ColliderShape::Plane => (KDW_COLLIDER_PLANE, 0.0, 0.0),
+            ColliderShape::InsideSphere { radius } => (KDW_COLLIDER_INSIDE_SPHERE, radius, 0.0),
+            ColliderShape::InsideCapsule { radius, half_height } => (KDW_COLLIDER_INSIDE_CAPSULE, radius, half_height),
+        };
+        Self {
+            struct_size: size_of::<Self>() as u32,
+            shape,
+            radius,
+            half_height,
+            transform: d.transform.into(),
+            layers: d.layers,
+        }
+    }
+}
+
+impl TryFrom<&kdw_collider_def> for ColliderDef {
+    type Error = crate::core::Error;
+    fn try_from(d: &kdw_collider_def) -> Result<Self, Self::Error> {
+        let (radius, half_height) = (d.radius, d.half_height);
+        let shape = match d.shape {
+            KDW_COLLIDER_SPHERE => ColliderShape::Sphere { radius },
+            KDW_COLLIDER_CAPSULE => ColliderShape::Capsule { radius, half_height },
+            KDW_COLLIDER_PLANE => ColliderShape::Plane,
+            KDW_COLLIDER_INSIDE_SPHERE => ColliderShape::InsideSphere { radius },
+            KDW_COLLIDER_INSIDE_CAPSULE => ColliderShape::InsideCapsule { radius, half_height },
+            other => return Err(crate::core::Error::invalid_argument(format!("unknown collider shape {other}"))),
+        };
+        Ok(Self { shape, transform: d.transform.into(), layers: d.layers })
+    }
 }
 
 impl From<kdw_vec3> for Vec3 {
@@ -163,13 +254,24 @@ impl From<EngineSettings> for kdw_engine_def {
             time_scale: s.time_scale,
             teleport_distance: s.teleport_distance,
             teleport_angle: s.teleport_angle,
+            teleport_mode: match s.teleport_mode {
+                TeleportMode::CarryShape => KDW_TELEPORT_CARRY_SHAPE,
+                TeleportMode::Reset => KDW_TELEPORT_RESET,
+            },
+            scale: s.scale,
         }
     }
 }
 
-impl From<&kdw_engine_def> for EngineSettings {
-    fn from(d: &kdw_engine_def) -> Self {
-        Self {
+impl TryFrom<&kdw_engine_def> for EngineSettings {
+    type Error = crate::core::Error;
+    fn try_from(d: &kdw_engine_def) -> Result<Self, Self::Error> {
+        let teleport_mode = match d.teleport_mode {
+            KDW_TELEPORT_CARRY_SHAPE => TeleportMode::CarryShape,
+            KDW_TELEPORT_RESET => TeleportMode::Reset,
+            other => return Err(crate::core::Error::invalid_argument(format!("unknown teleport mode {other}"))),
+        };
+        Ok(Self {
             gravity: d.gravity.into(),
             substep_rate: d.substep_rate,
             max_substeps: d.max_substeps,
@@ -177,7 +279,9 @@ impl From<&kdw_engine_def> for EngineSettings {
             time_scale: d.time_scale,
             teleport_distance: d.teleport_distance,
             teleport_angle: d.teleport_angle,
-        }
+            teleport_mode,
+            scale: d.scale,
+        })
     }
 }
 
@@ -195,6 +299,8 @@ impl From<ChainParams> for kdw_chain_def {
                 AnchorSource::ViewReference => KDW_ANCHOR_VIEW_REFERENCE,
                 AnchorSource::Own => KDW_ANCHOR_OWN,
             },
+            collision_mask: p.collision_mask,
+            friction: p.friction,
         }
     }
 }
@@ -217,6 +323,8 @@ impl TryFrom<&kdw_chain_def> for ChainParams {
             radius: d.radius,
             gravity_scale: d.gravity_scale,
             anchor,
+            collision_mask: d.collision_mask,
+            friction: d.friction,
         })
     }
 }
@@ -229,11 +337,12 @@ impl From<Stats> for kdw_engine_stats {
             joint_count: s.joint_count,
             substeps_last_step: s.substeps_last_step,
             chains_asleep: s.chains_asleep,
-            reserved: 0,
+            collider_count: s.collider_count,
             substeps_total: s.substeps_total,
             solver_fallbacks: s.solver_fallbacks,
             time_dropped: s.time_dropped,
             simulated_time: s.simulated_time,
+            contact_pairs_tested: s.contact_pairs_tested,
         }
     }
 }
@@ -248,8 +357,9 @@ mod tests {
         assert_eq!(size_of::<kdw_vec3>(), 12);
         assert_eq!(size_of::<kdw_quat>(), 16);
         assert_eq!(size_of::<kdw_transform>(), 28);
-        assert_eq!(size_of::<kdw_engine_def>(), 4 + 12 + 6 * 4);
-        assert_eq!(size_of::<kdw_chain_def>(), 8 * 4);
-        assert_eq!(size_of::<kdw_engine_stats>(), 6 * 4 + 4 * 8);
+        assert_eq!(size_of::<kdw_engine_def>(), 4 + 12 + 8 * 4);
+        assert_eq!(size_of::<kdw_chain_def>(), 10 * 4);
+        assert_eq!(size_of::<kdw_engine_stats>(), 6 * 4 + 5 * 8);
+        assert_eq!(size_of::<kdw_collider_def>(), 4 * 4 + 28 + 4);
     }
 }

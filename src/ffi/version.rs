@@ -4,7 +4,7 @@
 use std::ffi::c_char;
 
 /// Bumped on every incompatible change of the C ABI (signatures, struct layouts, semantics).
-pub const KDW_ABI_VERSION: u32 = 1;
+pub const KDW_ABI_VERSION: u32 = 2;
 
 /// The ABI version of the loaded library.
 #[unsafe(no_mangle)]

@@ -1,0 +1,326 @@
+//! The contact pass (SPEC 3.7): pushes a chain's particles and segments out of (or, for inside colliders,
+//! back into) the colliders it can touch, with Coulomb friction, inside the solver iterations.
+//!
+//! Segments, not only particles, are tested against spheres and capsules, and each contact is found
+//! continuously in the collider's own frame: the material point's position at the start of the substep
+//! (under the collider's start pose) and at the end (under its end pose) span the relative motion, and a
+//! point that crossed the surface on the way is put back on the side it came from. So neither a fast chain
+//! nor a fast collider (a swinging arm) skips over the other between substeps.
+
+use glam::{DVec3, Vec3};
+
+use super::collider::{ColliderShape, ColliderSweep};
+
+/// Below this share of a root segment's length from its kinematic end, a contact cannot be resolved by
+/// turning the segment (the lever would multiply the push); the tip particle is tested instead.
+const ROOT_LEVER_MIN: f32 = 0.25;
+
+/// What the contact pass needs of a chain besides its positions.
+pub struct ContactInput<'a> {
+    /// This substep's sweeps of the colliders the chain can touch.
+    pub colliders: &'a [ColliderSweep],
+    /// Collision radius of each particle (m, already scaled).
+    pub radii: &'a [f32],
+    /// Coulomb friction coefficient.
+    pub friction: f32,
+}
+
+/// One Gauss-Seidel pass over the contacts. `start` are the positions at the start of the substep, `p` the
+/// current estimate of its end. Particle 0 is kinematic and never moved.
+pub fn collide(start: &[DVec3], p: &mut [DVec3], input: &ContactInput<'_>) -> ContactPass {
+    let mut result = ContactPass { tested: 0, touching: false, deepest: 0.0 };
+    for sweep in input.colliders {
+        let pass = match sweep.shape {
+            ColliderShape::Plane => collide_plane(start, p, sweep, input),
+            ColliderShape::InsideSphere { .. } | ColliderShape::InsideCapsule { .. } => {
+                collide_inside(start, p, sweep, input)
+            }
+            ColliderShape::Sphere { .. } | ColliderShape::Capsule { .. } => collide_outside(start, p, sweep, input),
+        };
+        result.tested += pass.tested;
+        result.touching |= pass.touching;
+        result.deepest = result.deepest.max(pass.deepest);
+    }
+    result
+}
+
+/// What a contact pass found.
+#[derive(Clone, Copy, Debug)]
+pub struct ContactPass {
+    /// (segment or particle, collider) pairs tested.
+    pub tested: u64,
+    /// Some pair was in contact and was corrected.
+    pub touching: bool,
+    /// The largest correction made (m).
+    pub deepest: f32,
+}
+
+fn collide_plane(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input: &ContactInput<'_>) -> ContactPass {
+    let mut touching = false;
+    let mut deepest = 0.0f32;
+    for j in 1..p.len() {
+        let local = sweep.end.to_local(p[j]);
+        let depth = input.radii[j] - local.y;
+        if depth > 0.0 {
+            touching = true;
+            deepest = deepest.max(depth);
+            let moved = sweep.start.to_local(start[j]);
+            let correction =
+                Vec3::Y * depth + friction(local + Vec3::Y * depth - moved, Vec3::Y, depth, input.friction);
+            p[j] += sweep.end.direction_to_world(correction);
+        }
+    }
+    ContactPass { tested: p.len() as u64 - 1, touching, deepest }
+}
+
+fn collide_inside(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input: &ContactInput<'_>) -> ContactPass {
+    let mut touching = false;
+    let mut deepest = 0.0f32;
+    let (radius, half_height) = sweep.shape.capsule().expect("inside colliders are capsules");
+    for j in 1..p.len() {
+        let local = sweep.end.to_local(p[j]);
+        let axis_point = Vec3::new(0.0, local.y.clamp(-half_height, half_height), 0.0);
+        let offset = local - axis_point;
+        let distance = offset.length();
+        let limit = (radius - input.radii[j]).max(0.0);
+        if distance > limit {
+            touching = true;
+            deepest = deepest.max(distance - limit);
+            let outward = offset / distance;
+            let depth = distance - limit;
+            let moved = sweep.start.to_local(start[j]);
+            let normal = -outward;
+            let correction = normal * depth + friction(local + normal * depth - moved, normal, depth, input.friction);
+            p[j] += sweep.end.direction_to_world(correction);
+        }
+    }
+    ContactPass { tested: p.len() as u64 - 1, touching, deepest }
+}
+
+fn collide_outside(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input: &ContactInput<'_>) -> ContactPass {
+    let mut touching = false;
+    let mut deepest = 0.0f32;
+    let (radius, half_height) = sweep.shape.capsule().expect("outside colliders are spheres or capsules");
+    let axis = (Vec3::new(0.0, -half_height, 0.0), Vec3::new(0.0, half_height, 0.0));
+    for k in 0..p.len() - 1 {
+        let (a, b) = (sweep.end.to_local(p[k]), sweep.end.to_local(p[k + 1]));
+        let (mut t, _) = closest_between_segments((a, b), axis);
+        // The root is kinematic: a contact next to it could only be met by a large turn of the segment.
+        if k == 0 && t < ROOT_LEVER_MIN {
+            t = 1.0;
+        }
+        let point = a.lerp(b, t);
+        let reach = radius + input.radii[k] + (input.radii[k + 1] - input.radii[k]) * t;
+        let before = sweep.start.to_local(start[k].lerp(start[k + 1], t as f64));
+        let Some((normal, depth)) = contact_outside(before, point, reach, half_height) else {
+            continue;
+        };
+        touching = true;
+        deepest = deepest.max(depth);
+        let correction = normal * depth + friction(point + normal * depth - before, normal, depth, input.friction);
+        // Move the segment's two ends so that the point at `t` moves by `correction` (unit masses; the root's
+        // inverse mass is 0).
+        let (wa, wb) = (if k == 0 { 0.0 } else { 1.0 - t }, t);
+        let scale = 1.0 / (wa * wa + wb * wb);
+        let world = sweep.end.direction_to_world(correction * scale);
+        p[k] += world * wa as f64;
+        p[k + 1] += world * wb as f64;
+    }
+    ContactPass { tested: p.len() as u64 - 1, touching, deepest }
+}
+
+/// The contact of a material point that moved (in the collider's frame) from `before` to `now` with the
+/// capsule of radius `reach` around the local Y segment of half length `half_height`: the outward normal
+/// and how far `now` lies behind the surface along it, or `None` when it is clear.
+///
+/// A point still on the side of the axis it came from is pushed out the shortest way. A point that came
+/// from outside and is now past the axis went through: it is put back on the tangent plane where its path
+/// entered, so it ends on the side it came from whatever the step size.
+fn contact_outside(before: Vec3, now: Vec3, reach: f32, half_height: f32) -> Option<(Vec3, f32)> {
+    let axis_point = |q: Vec3| Vec3::new(0.0, q.y.clamp(-half_height, half_height), 0.0);
+    let (from_axis_before, from_axis_now) = (before - axis_point(before), now - axis_point(now));
+    let started_outside = from_axis_before.length_squared() >= reach * reach;
+    if started_outside && from_axis_before.dot(from_axis_now) <= 0.0 {
+        if let Some((entry, normal)) = ray_capsule(before, now, reach, half_height) {
+            let depth = (entry - now).dot(normal);
+            return (depth > 0.0).then_some((normal, depth));
+        }
+    }
+    let distance = from_axis_now.length();
+    if distance >= reach {
+        return None;
+    }
+    // On its own side, or overlapping since the start of the substep (e.g. a collider created inside the
+    // chain): out along the shortest way, or any way from the axis itself.
+    let normal = if distance > 1e-12 { from_axis_now / distance } else { fallback_normal(from_axis_before) };
+    Some((normal, reach - distance))
+}
+
+fn fallback_normal(v: Vec3) -> Vec3 {
+    let horizontal = Vec3::new(v.x, 0.0, v.z);
+    horizontal.try_normalize().unwrap_or(Vec3::X)
+}
+
+/// Coulomb friction for a contact whose normal push was `depth`: the tangential part of the point's motion
+/// relative to the collider, `motion`, is cancelled up to `coefficient * depth` (position-based friction,
+/// Macklin et al. 2014).
+fn friction(motion: Vec3, normal: Vec3, depth: f32, coefficient: f32) -> Vec3 {
+    if coefficient <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let tangential = motion - normal * motion.dot(normal);
+    let length = tangential.length();
+    if length <= 1e-12 {
+        return Vec3::ZERO;
+    }
+    -tangential * (coefficient * depth / length).min(1.0)
+}
+
+/// Where the path from `from` to `to` (starting outside) first enters the capsule of radius `radius`
+/// around the local Y segment of half length `half_height`, and the outward normal there.
+fn ray_capsule(from: Vec3, to: Vec3, radius: f32, half_height: f32) -> Option<(Vec3, Vec3)> {
+    let d = to - from;
+    let mut best: Option<(f32, Vec3)> = None;
+    let mut consider = |u: f32, normal: Vec3| {
+        if (0.0..=1.0).contains(&u) && best.is_none_or(|(b, _)| u < b) {
+            best = Some((u, normal));
+        }
+    };
+    // The cylinder between the caps.
+    let a = d.x * d.x + d.z * d.z;
+    if a > 1e-12 {
+        let b = from.x * d.x + from.z * d.z;
+        let c = from.x * from.x + from.z * from.z - radius * radius;
+        let disc = b * b - a * c;
+        if disc >= 0.0 {
+            let u = (-b - disc.sqrt()) / a;
+            let hit = from + d * u;
+            if hit.y.abs() <= half_height {
+                consider(u, Vec3::new(hit.x, 0.0, hit.z) / radius);
+            }
+        }
+    }
+    // The two caps (one when the capsule is a sphere).
+    let a = d.length_squared();
+    if a > 1e-12 {
+        for centre_y in if half_height > 0.0 { [-half_height, half_height] } else { [0.0, 0.0] } {
+            let centre = Vec3::new(0.0, centre_y, 0.0);
+            let oc = from - centre;
+            let b = oc.dot(d);
+            let c = oc.length_squared() - radius * radius;
+            let disc = b * b - a * c;
+            if disc >= 0.0 {
+                let u = (-b - disc.sqrt()) / a;
+                consider(u, (from + d * u - centre) / radius);
+            }
+        }
+    }
+    best.map(|(u, normal)| (from + d * u, normal.normalize_or(Vec3::X)))
+}
+
+/// Parameters `(s, t)` of the closest points of segments `p` and `q` (Ericson, Real-Time Collision
+/// Detection, 5.1.9), each in [0, 1].
+fn closest_between_segments(p: (Vec3, Vec3), q: (Vec3, Vec3)) -> (f32, f32) {
+    let (d1, d2) = (p.1 - p.0, q.1 - q.0);
+    let r = p.0 - q.0;
+    let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
+    const EPS: f32 = 1e-12;
+    if a <= EPS && e <= EPS {
+        return (0.0, 0.0);
+    }
+    if a <= EPS {
+        return (0.0, (f / e).clamp(0.0, 1.0));
+    }
+    let c = d1.dot(r);
+    if e <= EPS {
+        return ((-c / a).clamp(0.0, 1.0), 0.0);
+    }
+    let b = d1.dot(d2);
+    let denom = a * e - b * b;
+    let mut s = if denom > EPS { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+    let mut t = (b * s + f) / e;
+    if t < 0.0 {
+        t = 0.0;
+        s = (-c / a).clamp(0.0, 1.0);
+    } else if t > 1.0 {
+        t = 1.0;
+        s = ((b - c) / a).clamp(0.0, 1.0);
+    }
+    (s, t)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Quat;
+
+    use super::super::collider::ColliderPose;
+    use super::*;
+
+    fn still(shape: ColliderShape) -> ColliderSweep {
+        let pose = ColliderPose { centre: DVec3::ZERO, rotation: Quat::IDENTITY };
+        ColliderSweep { shape, start: pose, end: pose }
+    }
+
+    #[test]
+    fn closest_points_of_crossing_segments() {
+        let (s, t) = closest_between_segments(
+            (Vec3::new(-1.0, 0.5, 0.0), Vec3::new(1.0, 0.5, 0.0)),
+            (Vec3::new(0.0, -1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)),
+        );
+        assert!((s - 0.5).abs() < 1e-6 && (t - 0.75).abs() < 1e-6, "{s} {t}");
+    }
+
+    #[test]
+    fn ray_enters_capsule_side_and_cap() {
+        let (entry, normal) = ray_capsule(Vec3::new(-2.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 0.0), 0.5, 1.0).unwrap();
+        assert!((entry - Vec3::new(-0.5, 0.0, 0.0)).length() < 1e-6 && (normal + Vec3::X).length() < 1e-6);
+        let (entry, normal) = ray_capsule(Vec3::new(0.0, 3.0, 0.0), Vec3::new(0.0, 0.0, 0.0), 0.5, 1.0).unwrap();
+        assert!((entry - Vec3::new(0.0, 1.5, 0.0)).length() < 1e-6 && (normal - Vec3::Y).length() < 1e-6);
+        assert!(ray_capsule(Vec3::new(-2.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 1.0), 0.5, 1.0).is_none());
+    }
+
+    #[test]
+    fn point_that_passed_through_goes_back_to_its_side() {
+        // From the left of a sphere of reach 0.5 straight through to the right: back onto the left surface.
+        let (normal, depth) = contact_outside(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.7, 0.0, 0.0), 0.5, 0.0).unwrap();
+        assert!((normal + Vec3::X).length() < 1e-6 && (depth - 1.2).abs() < 1e-6, "{normal} {depth}");
+    }
+
+    #[test]
+    fn segment_across_a_sphere_is_pushed_out_at_its_middle() {
+        // A segment whose ends are both outside a sphere but whose middle passes through it.
+        let start = [DVec3::new(-1.0, 0.5, 0.0), DVec3::new(-0.5, 0.5, 0.0), DVec3::new(0.5, 0.5, 0.0)];
+        let mut p = [DVec3::new(-1.0, 0.2, 0.0), DVec3::new(-0.5, 0.2, 0.0), DVec3::new(0.5, 0.2, 0.0)];
+        let sweep = still(ColliderShape::Sphere { radius: 0.4 });
+        let input = ContactInput { colliders: &[sweep], radii: &[0.0; 3], friction: 0.0 };
+        collide(&start, &mut p, &input);
+        let (a, b) = (p[1].as_vec3(), p[2].as_vec3());
+        let (t, _) = closest_between_segments((a, b), (Vec3::ZERO, Vec3::ZERO));
+        let distance = a.lerp(b, t).length();
+        assert!(distance >= 0.4 - 1e-5, "segment still inside: {distance}");
+        assert_eq!(p[0], DVec3::new(-1.0, 0.2, 0.0), "the root never moves");
+    }
+
+    #[test]
+    fn plane_friction_stops_slow_sliding_and_not_fast() {
+        let plane = still(ColliderShape::Plane);
+        let start = [DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0)];
+        // Pressed 0.1 into the plane while sliding 0.05 sideways: friction 1 holds it (0.05 < 1 * 0.1).
+        let mut p = [DVec3::ZERO, DVec3::new(1.05, -0.1, 0.0)];
+        collide(&start, &mut p, &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0 });
+        assert!((p[1] - DVec3::new(1.0, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
+        // Sliding 0.5: friction removes 0.1 of it.
+        let mut p = [DVec3::ZERO, DVec3::new(1.5, -0.1, 0.0)];
+        collide(&start, &mut p, &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0 });
+        assert!((p[1] - DVec3::new(1.4, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
+    }
+
+    #[test]
+    fn inside_sphere_keeps_particles_within_radius_minus_their_own() {
+        let sweep = still(ColliderShape::InsideSphere { radius: 1.0 });
+        let start = [DVec3::ZERO, DVec3::new(0.5, 0.0, 0.0)];
+        let mut p = [DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0)];
+        collide(&start, &mut p, &ContactInput { colliders: &[sweep], radii: &[0.1; 2], friction: 0.0 });
+        assert!((p[1] - DVec3::new(0.9, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
+    }
+}

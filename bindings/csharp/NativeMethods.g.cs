@@ -562,6 +562,17 @@ namespace Kodawari.Native
         /// </summary>
         public uint teleport_mode;
         /// <summary>
+        ///  A chain whose joints all move slower than this relative to its root (character units/s, × `scale`)
+        ///  for 0.5 s, under a still anchor, rest shape and colliders, sleeps until any of them changes. In
+        ///  [0, 1e6]; 0 never sleeps. Default 1e-4.
+        /// </summary>
+        public float sleep_speed;
+        /// <summary>
+        ///  Level of detail for distant characters, in [0, 3]: each level halves the internal step rate (not
+        ///  below 30 Hz) and the iterations (not below 1). Default 0.
+        /// </summary>
+        public uint lod;
+        /// <summary>
         ///  Size of the character relative to the units its parameters are tuned in, in [1e-6, 1e6]: multiplies
         ///  gravity, `teleport_distance` and chain/joint radii, so a character scaled by 100 with scale 100 moves
         ///  like the unscaled one. Transforms and collider sizes are world units. Default 1.

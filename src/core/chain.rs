@@ -62,6 +62,12 @@ pub struct Chain {
     pub(crate) joint_radii: Vec<f32>,
     /// An explicit teleport was asked for: the next step treats the anchor's motion as one.
     pub(crate) teleport_requested: bool,
+    /// A disabled (culled) chain is not simulated; it follows its anchor rigidly.
+    pub(crate) enabled: bool,
+    /// Sleeping: nothing moved for a while; the chain is skipped until something changes.
+    pub(crate) asleep: bool,
+    /// Simulated seconds the chain has been still (towards falling asleep).
+    pub(crate) still_time: f32,
 }
 
 impl Chain {
@@ -97,6 +103,9 @@ impl Chain {
             output: local,
             joint_radii: Vec::new(),
             teleport_requested: false,
+            enabled: true,
+            asleep: false,
+            still_time: 0.0,
         };
         chain.update_rest(None);
         chain.rest_used.clone_from(&chain.rest);
@@ -139,6 +148,28 @@ impl Chain {
 
     pub(crate) fn mark_shapes_dirty(&mut self) {
         self.shapes_dirty = true;
+        self.wake();
+    }
+
+    /// Something about the chain changed: simulate it again from the next step.
+    pub(crate) fn wake(&mut self) {
+        self.asleep = false;
+        self.still_time = 0.0;
+    }
+
+    /// Fastest particle speed relative to the root, from the internal velocities.
+    pub(crate) fn relative_speed(&self) -> f32 {
+        let root = self.state.v[0];
+        self.state.v[1..].iter().map(|v| (*v - root).length_squared()).fold(0.0, f32::max).sqrt()
+    }
+
+    /// Falls asleep: velocities to zero and the output pose frozen at the newest internal state.
+    pub(crate) fn fall_asleep(&mut self) {
+        self.asleep = true;
+        self.state.v.fill(Vec3::ZERO);
+        self.state.w.fill(Vec3::ZERO);
+        self.local_previous.clone_from(&self.local_current);
+        self.write_output(1.0);
     }
 
     /// Replaces the base shape (same joint count). View shapes keep their bends and take the new lengths.

@@ -12,7 +12,9 @@ use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderS
 use super::collision::ContactInput;
 use super::error::{Error, Result};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
-use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, TeleportMode};
+use super::params::{
+    AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, SLEEP_DELAY, TeleportMode,
+};
 use super::rod::{RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
 
@@ -106,7 +108,15 @@ impl Engine {
     pub fn set_settings(&mut self, settings: EngineSettings) -> Result<()> {
         settings.validate()?;
         self.settings = settings;
+        self.wake_all();
         Ok(())
+    }
+
+    /// Every chain simulates again from the next step (settings or colliders changed).
+    fn wake_all(&mut self) {
+        for &slot in &self.order {
+            self.chains.at_mut(slot as usize).expect("live").wake();
+        }
     }
 
     pub fn set_gravity(&mut self, gravity: Vec3) -> Result<()> {
@@ -186,7 +196,9 @@ impl Engine {
 
     pub fn set_chain_params(&mut self, id: ChainId, params: ChainParams) -> Result<()> {
         params.validate()?;
-        self.chain_mut(id)?.params = params;
+        let chain = self.chain_mut(id)?;
+        chain.params = params;
+        chain.wake();
         Ok(())
     }
 
@@ -253,7 +265,29 @@ impl Engine {
         let chain = self.chain_mut(id)?;
         chain.joint_radii.clear();
         chain.joint_radii.extend_from_slice(radii);
+        chain.wake();
         Ok(())
+    }
+
+    /// A disabled (culled) chain is not simulated and costs nothing; it follows its anchor rigidly in its last
+    /// pose. Enabled again, it carries on from that pose as after a teleport (no whip).
+    pub fn set_chain_enabled(&mut self, id: ChainId, enabled: bool) -> Result<()> {
+        let chain = self.chain_mut(id)?;
+        if enabled && !chain.enabled {
+            chain.teleport_requested = true;
+            chain.wake();
+        }
+        chain.enabled = enabled;
+        Ok(())
+    }
+
+    pub fn is_chain_enabled(&self, id: ChainId) -> Result<bool> {
+        Ok(self.chain(id)?.enabled)
+    }
+
+    /// Whether the chain slept through the last step.
+    pub fn is_chain_asleep(&self, id: ChainId) -> Result<bool> {
+        Ok(self.chain(id)?.asleep)
     }
 
     /// The next step treats the chain's anchor motion as a teleport (see [`TeleportMode`]), whatever its size.
@@ -280,6 +314,7 @@ impl Engine {
             return Err(Error::capacity("the engine holds the maximum number of colliders"));
         }
         let id = self.colliders.insert(Collider::new(def, pose)).expect("room checked above");
+        self.wake_all();
         self.collider_order.push(self.colliders.index_of(id).expect("just inserted") as u32);
         Ok(Id::from_bits(id.to_bits()))
     }
@@ -289,6 +324,7 @@ impl Engine {
         let index = self.colliders.index_of(own).ok_or_else(|| collider_not_found(id))?;
         self.colliders.remove(own);
         self.collider_order.retain(|&slot| slot as usize != index);
+        self.wake_all();
         Ok(())
     }
 
@@ -310,6 +346,7 @@ impl Engine {
     /// Changes a collider's layers.
     pub fn set_collider_layers(&mut self, id: ColliderId, layers: u32) -> Result<()> {
         self.colliders.get_mut(Id::from_bits(id.to_bits())).ok_or_else(|| collider_not_found(id))?.layers = layers;
+        self.wake_all();
         Ok(())
     }
 
@@ -455,7 +492,8 @@ impl Engine {
 
         // Clock: fixed substeps from an accumulator, capped.
         let settings = self.settings;
-        let h = 1.0 / settings.substep_rate as f64;
+        let h = 1.0 / settings.effective_substep_rate() as f64;
+        let iterations = settings.effective_iterations();
         let simulated = dt as f64 * settings.time_scale as f64;
         let before = self.accumulator;
         let mut available = before + simulated;
@@ -480,6 +518,7 @@ impl Engine {
 
         let mut fallbacks = 0u64;
         let mut contact_pairs = 0u64;
+        let mut idle = 0u32;
         for &slot in &self.order {
             let chain = self.chains.at_mut(slot as usize).expect("live");
             let anchor_world = match chain.params.anchor {
@@ -489,6 +528,12 @@ impl Engine {
             let to_relative = |t: &Transform| Transform::new(t.position - origin, t.rotation);
             let target = to_relative(&anchor_world);
             let mut start = to_relative(&chain.anchor);
+            if !chain.enabled {
+                chain.anchor = anchor_world;
+                idle += 1;
+                continue;
+            }
+            let anchor_still = start == target && chain.placed;
             chain.update_rest(self.view);
             let teleport = std::mem::take(&mut chain.teleport_requested)
                 || is_teleport(&start, &target, teleport_distance, settings.teleport_angle);
@@ -525,8 +570,22 @@ impl Engine {
                 }
             }
 
+            // Sleeping (SPEC 3.8): skipped while its anchor, rest shape and nearby colliders stay still.
+            let colliders_moving = contacts.candidates.iter().any(|&c| {
+                let (first, last) = (&contacts.sweeps[c], &contacts.sweeps[(substeps as usize - 1) * collider_count + c]);
+                first.start.centre != last.end.centre || first.start.rotation != last.end.rotation
+            });
+            let still = anchor_still && !teleport && !chain.rest_changed && !colliders_moving;
+            if chain.asleep {
+                if still {
+                    idle += 1;
+                    continue;
+                }
+                chain.wake();
+            }
+
             let params = chain.params;
-            let alpha = params.alpha_per_iteration(h as f32, settings.iterations);
+            let alpha = params.alpha_per_iteration(h as f32, iterations);
             let decay = (-params.damping * h as f32).exp();
             let suppression_share = params.momentum_suppression * params.alpha_per_substep(h as f32);
             for s in 0..substeps {
@@ -558,7 +617,7 @@ impl Engine {
                     gravity: settings.gravity * (params.gravity_scale * settings.scale),
                     velocity_decay: decay,
                     alpha_per_iteration: alpha,
-                    iterations: settings.iterations,
+                    iterations,
                     inv_mass: 1.0 / params.mass,
                     orientation_weight: (params.radius * settings.scale).powi(2) / 5.0,
                     rest: &chain.rest,
@@ -578,6 +637,16 @@ impl Engine {
                 }
             }
             chain.write_output((after / h) as f32);
+            if settings.sleep_speed > 0.0 && substeps > 0 {
+                if still && chain.relative_speed() < settings.sleep_speed * settings.scale {
+                    chain.still_time += (substeps as f64 * h) as f32;
+                    if chain.still_time >= SLEEP_DELAY {
+                        chain.fall_asleep();
+                    }
+                } else {
+                    chain.still_time = 0.0;
+                }
+            }
         }
         if substeps > 0 {
             for &slot in &self.collider_order {
@@ -587,6 +656,7 @@ impl Engine {
         }
         self.accumulator = after;
         self.stats.contact_pairs_tested += contact_pairs;
+        self.stats.chains_asleep = idle;
         self.stats.substeps_last_step = substeps as u32;
         self.stats.substeps_total += substeps;
         self.stats.solver_fallbacks += fallbacks;
@@ -769,6 +839,7 @@ impl Engine {
             s.teleport_distance,
             s.teleport_angle,
             s.scale,
+            s.sleep_speed,
         ] {
             f(x);
         }
@@ -780,6 +851,7 @@ impl Engine {
             s.max_substeps as u64,
             s.iterations as u64,
             s.teleport_mode as u64,
+            s.lod as u64,
             self.order.len() as u64,
             self.collider_order.len() as u64,
         ];
@@ -799,8 +871,11 @@ impl Engine {
                 chain.placed as u64
                     | (chain.half_kick as u64) << 1
                     | (chain.rest_changed as u64) << 2
-                    | (chain.teleport_requested as u64) << 3,
+                    | (chain.teleport_requested as u64) << 3
+                    | (chain.enabled as u64) << 4
+                    | (chain.asleep as u64) << 5,
             );
+            words.push(chain.still_time.to_bits() as u64);
             words.push(p.collision_mask as u64);
             words.extend(chain.joint_radii.iter().chain([&p.friction]).map(|x| x.to_bits() as u64));
             words.push(chain.views.len() as u64);

@@ -44,6 +44,15 @@ pub struct EngineSettings {
     pub teleport_angle: f32,
     /// What a teleport does to a chain.
     pub teleport_mode: TeleportMode,
+    /// A chain whose particles all move slower than this relative to its root (character units/s, × `scale`)
+    /// for `SLEEP_DELAY` seconds, under a still anchor, rest shape and colliders, sleeps: it costs almost
+    /// nothing until any of them changes. In [0, 1e6]; 0 never sleeps. Default 5e-6: low enough that a chain
+    /// falls asleep within 1e-5 chain lengths of its resting pose (SPEC 6.1 rest fidelity).
+    pub sleep_speed: f32,
+    /// Level of detail for distant characters, in [0, 3]: each level halves the internal step rate (not
+    /// below 30 Hz) and the iterations (not below 1). Stiffness and damping keep their meaning; accuracy
+    /// drops as `docs/accuracy.md` shows. Default 0.
+    pub lod: u32,
     /// Size of the character relative to the units its parameters are tuned in, dimensionless, in
     /// [1e-6, 1e6]. Multiplies every length-valued parameter: gravity, `teleport_distance`, chain and joint
     /// radii. A character scaled by 100 with `scale` 100 moves exactly like the unscaled one, 100 times
@@ -62,6 +71,8 @@ impl Default for EngineSettings {
             teleport_distance: 1.0,
             teleport_angle: std::f32::consts::FRAC_PI_2,
             teleport_mode: TeleportMode::CarryShape,
+            sleep_speed: 5e-6,
+            lod: 0,
             scale: 1.0,
         }
     }
@@ -90,14 +101,26 @@ impl EngineSettings {
         check(self.teleport_angle > 0.0 && self.teleport_angle.is_finite(), || {
             format!("teleport_angle {} must be finite and > 0", self.teleport_angle)
         })?;
+        check((0.0..=1e6).contains(&self.sleep_speed), || format!("sleep_speed {} outside [0, 1e6]", self.sleep_speed))?;
+        check(self.lod <= MAX_LOD, || format!("lod {} outside [0, {MAX_LOD}]", self.lod))?;
         check((MIN_SCALE..=MAX_SCALE).contains(&self.scale), || {
             format!("scale {} outside [{MIN_SCALE}, {MAX_SCALE}]", self.scale)
         })?;
         Ok(())
     }
 
+    /// The internal step rate after the level of detail.
+    pub fn effective_substep_rate(&self) -> f32 {
+        (self.substep_rate / (1u32 << self.lod) as f32).max(MIN_SUBSTEP_RATE.min(self.substep_rate))
+    }
+
+    /// The iterations after the level of detail.
+    pub fn effective_iterations(&self) -> u32 {
+        (self.iterations >> self.lod).max(1)
+    }
+
     pub fn substep(&self) -> f32 {
-        1.0 / self.substep_rate
+        1.0 / self.effective_substep_rate()
     }
 }
 
@@ -136,6 +159,11 @@ pub const MIN_MASS: f32 = 1e-6;
 pub const MAX_MASS: f32 = 1e6;
 pub const MAX_RADIUS: f32 = 1e6;
 pub const MAX_FRICTION: f32 = 10.0;
+pub const MAX_LOD: u32 = 3;
+/// Lowest internal step rate (Hz) a level of detail goes down to.
+pub const MIN_SUBSTEP_RATE: f32 = 30.0;
+/// Seconds a chain must stay below `sleep_speed` before it sleeps.
+pub const SLEEP_DELAY: f32 = 0.5;
 /// Range of the engine's `scale`: characters from micrometre to kilometre size relative to their tuning.
 pub const MIN_SCALE: f32 = 1e-6;
 pub const MAX_SCALE: f32 = 1e6;

@@ -79,6 +79,13 @@ pub struct kdw_engine_def {
     pub teleport_angle: f32,
     /// What a teleport does: `KDW_TELEPORT_CARRY_SHAPE` (default) or `KDW_TELEPORT_RESET`.
     pub teleport_mode: u32,
+    /// A chain whose joints all move slower than this relative to its root (character units/s, × `scale`)
+    /// for 0.5 s, under a still anchor, rest shape and colliders, sleeps until any of them changes. In
+    /// [0, 1e6]; 0 never sleeps. Default 5e-6 (falls asleep within 1e-5 chain lengths of its resting pose).
+    pub sleep_speed: f32,
+    /// Level of detail for distant characters, in [0, 3]: each level halves the internal step rate (not
+    /// below 30 Hz) and the iterations (not below 1). Default 0.
+    pub lod: u32,
     /// Size of the character relative to the units its parameters are tuned in, in [1e-6, 1e6]: multiplies
     /// gravity, `teleport_distance` and chain/joint radii, so a character scaled by 100 with scale 100 moves
     /// like the unscaled one. Transforms and collider sizes are world units. Default 1.
@@ -258,6 +265,8 @@ impl From<EngineSettings> for kdw_engine_def {
                 TeleportMode::CarryShape => KDW_TELEPORT_CARRY_SHAPE,
                 TeleportMode::Reset => KDW_TELEPORT_RESET,
             },
+            sleep_speed: s.sleep_speed,
+            lod: s.lod,
             scale: s.scale,
         }
     }
@@ -280,6 +289,8 @@ impl TryFrom<&kdw_engine_def> for EngineSettings {
             teleport_distance: d.teleport_distance,
             teleport_angle: d.teleport_angle,
             teleport_mode,
+            sleep_speed: d.sleep_speed,
+            lod: d.lod,
             scale: d.scale,
         })
     }
@@ -357,7 +368,7 @@ mod tests {
         assert_eq!(size_of::<kdw_vec3>(), 12);
         assert_eq!(size_of::<kdw_quat>(), 16);
         assert_eq!(size_of::<kdw_transform>(), 28);
-        assert_eq!(size_of::<kdw_engine_def>(), 4 + 12 + 8 * 4);
+        assert_eq!(size_of::<kdw_engine_def>(), 4 + 12 + 10 * 4);
         assert_eq!(size_of::<kdw_chain_def>(), 10 * 4);
         assert_eq!(size_of::<kdw_engine_stats>(), 6 * 4 + 5 * 8);
         assert_eq!(size_of::<kdw_collider_def>(), 4 * 4 + 28 + 4);

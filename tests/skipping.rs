@@ -1,0 +1,196 @@
+//! Skipping what a scene does not need (SPEC 3.8, issue 5): sleeping, disabled chains, level of detail, and
+//! engines stepped from several threads at once.
+
+mod common;
+
+use common::*;
+use glam::{Quat, Vec3};
+use kodawari::{ChainParams, ColliderDef, ColliderShape, Engine, EngineSettings, Transform};
+
+const HEAD: Vec3 = Vec3::new(0.0, 1.6, 0.0);
+const CAMERA: Vec3 = Vec3::new(0.0, 1.6, 5.0);
+
+fn settle(engine: &mut Engine, seconds: f32) {
+    for _ in 0..(seconds * 60.0) as usize {
+        engine.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
+    }
+}
+
+/// A chain hanging under gravity comes to rest, falls asleep, and then does not move at all; its pose is
+/// within 1e-5 chain lengths of a chain that never sleeps.
+#[test]
+fn a_settled_chain_sleeps_where_it_would_rest() {
+    let base = straight_chain(8, Vec3::ZERO, Vec3::new(1.0, -0.5, 0.0), 0.05);
+    let params = ChainParams { damping: 3.0, ..Default::default() };
+    let mut sleeping = engine_with(EngineSettings::default());
+    let mut awake = engine_with(EngineSettings { sleep_speed: 0.0, ..Default::default() });
+    let a = sleeping.create_chain(params, &base).unwrap();
+    let b = awake.create_chain(params, &base).unwrap();
+    let mut fell_asleep_at = None;
+    for frame in 0..(60 * 30) {
+        sleeping.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
+        awake.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
+        if fell_asleep_at.is_none() && sleeping.is_chain_asleep(a).unwrap() {
+            fell_asleep_at = Some(frame as f32 / 60.0);
+        }
+    }
+    let seconds = fell_asleep_at.expect("the chain never fell asleep in 30 s");
+    assert_eq!(sleeping.stats().chains_asleep, 1);
+    assert_eq!(awake.stats().chains_asleep, 0);
+    let difference = chain_world(&sleeping, a)
+        .iter()
+        .zip(chain_world(&awake, b))
+        .map(|(x, y)| (x.position - y.position).length())
+        .fold(0.0, f32::max)
+        / chain_length(&base);
+    println!("fell asleep after {seconds:.2} s; pose differs from a never-sleeping chain by {difference:.2e} chain lengths");
+    assert!(difference <= 1e-5, "{difference}");
+    let pose = chain_world(&sleeping, a);
+    settle(&mut sleeping, 1.0);
+    assert_eq!(chain_world(&sleeping, a), pose, "a sleeping chain does not move");
+    assert_eq!(sleeping.chain_kinetic_energy(a).unwrap(), 0.0);
+}
+
+/// Anything that changes a chain's situation wakes it: its anchor, its parameters, the view when it has view
+/// shapes, a collider moving near it, gravity.
+#[test]
+fn any_change_wakes_a_sleeping_chain() {
+    let fresh = || {
+        let mut engine = engine_with(EngineSettings { sleep_speed: 1e-3, ..Default::default() });
+        let base = straight_chain(6, Vec3::ZERO, -Vec3::Y, 0.05);
+        let id = engine.create_chain(ChainParams { damping: 5.0, ..Default::default() }, &base).unwrap();
+        let side = curled_chain(6, Vec3::ZERO, -Vec3::Y, Vec3::Z, 0.2, 0.05);
+        engine.add_view_shape(id, Vec3::X, &side, 1.0).unwrap();
+        let def = ColliderDef {
+            shape: ColliderShape::Sphere { radius: 0.05 },
+            transform: at(HEAD + Vec3::new(0.2, -0.1, 0.0)),
+            layers: 1,
+        };
+        engine.create_collider(&def).unwrap();
+        settle(&mut engine, 10.0);
+        assert!(engine.is_chain_asleep(id).unwrap(), "precondition: asleep");
+        (engine, id)
+    };
+    type Change = fn(&mut Engine, kodawari::ChainId) -> (Vec3, Transform);
+    let changes: [(&str, Change); 5] = [
+        ("anchor moved", |_, _| (CAMERA, at(HEAD + Vec3::X * 0.01))),
+        ("view changed", |_, _| (HEAD + Vec3::new(3.0, 0.0, 1.0), at(HEAD))),
+        ("parameters changed", |e, id| {
+            let params = ChainParams { stiffness: 0.2, ..e.chain_params(id).unwrap() };
+            e.set_chain_params(id, params).unwrap();
+            (CAMERA, at(HEAD))
+        }),
+        ("collider moved", |e, _| {
+            e.set_collider_transforms([at(HEAD + Vec3::new(0.05, -0.1, 0.0))].into_iter()).unwrap();
+            (CAMERA, at(HEAD))
+        }),
+        ("gravity changed", |e, _| {
+            e.set_gravity(Vec3::new(0.0, -9.81, 3.0)).unwrap();
+            (CAMERA, at(HEAD))
+        }),
+    ];
+    for (what, change) in changes {
+        let (mut engine, id) = fresh();
+        let (camera, k) = change(&mut engine, id);
+        engine.step(1.0 / 60.0, camera, k).unwrap();
+        assert!(!engine.is_chain_asleep(id).unwrap(), "{what}: still asleep");
+        assert_eq!(engine.stats().chains_asleep, 0, "{what}");
+    }
+    // A collider moving far away does not.
+    let (mut engine, id) = fresh();
+    engine.set_collider_transforms([at(HEAD + Vec3::new(30.0, 0.0, 0.0))].into_iter()).unwrap();
+    engine.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
+    settle(&mut engine, 0.1);
+    engine.set_collider_transforms([at(HEAD + Vec3::new(31.0, 0.0, 0.0))].into_iter()).unwrap();
+    engine.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
+    assert!(engine.is_chain_asleep(id).unwrap(), "a far collider woke the chain");
+}
+
+/// A disabled chain is not simulated (counted as idle), follows its anchor rigidly, and enabled again
+/// carries on without a whip.
+#[test]
+fn disabled_chain_costs_nothing_and_follows_its_anchor() {
+    let mut engine = engine_with(EngineSettings::default());
+    let base = straight_chain(8, Vec3::ZERO, Vec3::X, 0.05);
+    let id = engine.create_chain(limp(), &base).unwrap();
+    settle(&mut engine, 0.3);
+    engine.set_chain_enabled(id, false).unwrap();
+    engine.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
+    let frozen: Vec<Vec3> = chain_world(&engine, id).iter().map(|t| t.position - HEAD).collect();
+    let substeps_before = engine.stats().substeps_total;
+    let moved = HEAD + Vec3::new(2.0, 0.5, 0.0);
+    for _ in 0..30 {
+        engine.step(1.0 / 60.0, moved + Vec3::Z * 5.0, at(moved)).unwrap();
+    }
+    assert_eq!(engine.stats().chains_asleep, 1);
+    let now: Vec<Vec3> = chain_world(&engine, id).iter().map(|t| t.position - moved).collect();
+    let drift = frozen.iter().zip(&now).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+    assert!(drift <= 1e-6, "a disabled chain moves rigidly with its anchor: {drift}");
+    assert!(engine.stats().substeps_total > substeps_before, "the clock still runs");
+    engine.set_chain_enabled(id, true).unwrap();
+    let energy_before = engine.chain_kinetic_energy(id).unwrap();
+    engine.step(1.0 / 60.0, moved + Vec3::Z * 5.0, at(moved)).unwrap();
+    // Re-enabled: the jump from where it was disabled is carried, so only gravity adds energy.
+    let energy_after = engine.chain_kinetic_energy(id).unwrap();
+    println!("re-enabled after a 2 m move: kinetic energy {energy_before:.3} J -> {energy_after:.3} J");
+    assert!(energy_after < energy_before + 1.0, "{energy_before} -> {energy_after}");
+    assert_eq!(engine.stats().chains_asleep, 0);
+}
+
+/// Each level of detail halves the internal step rate (not below 30 Hz) and the iterations (not below 1).
+#[test]
+fn level_of_detail_lowers_the_step_rate() {
+    for (lod, substeps) in [(0u32, 4u32), (1, 2), (2, 1)] {
+        let mut engine = engine_with(EngineSettings { lod, ..Default::default() });
+        engine.create_chain(ChainParams::default(), &straight_chain(6, Vec3::ZERO, Vec3::X, 0.05)).unwrap();
+        let mut counts = Vec::new();
+        for _ in 0..6 {
+            engine.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
+            counts.push(engine.stats().substeps_last_step);
+        }
+        assert_eq!(counts.iter().sum::<u32>(), 6 * substeps, "lod {lod}: {counts:?}");
+    }
+    let settings = EngineSettings { lod: 3, ..Default::default() };
+    assert_eq!(settings.effective_substep_rate(), 30.0);
+    assert_eq!(settings.effective_iterations(), 1);
+    assert!(Engine::new(EngineSettings { lod: 4, ..Default::default() }).is_err());
+}
+
+/// Distinct engines step from several threads at once with the same results, bit for bit, as one thread.
+#[test]
+fn engines_step_in_parallel_with_serial_results() {
+    fn scene(seed: usize) -> Engine {
+        let mut engine = engine_with(EngineSettings::default());
+        for c in 0..4 {
+            let direction = Vec3::new(1.0, -0.3 * c as f32, 0.1 * seed as f32);
+            engine.create_chain(ChainParams::default(), &straight_chain(6 + c, Vec3::ZERO, direction, 0.04)).unwrap();
+        }
+        engine
+    }
+    fn run(engine: &mut Engine, seed: usize) {
+        for frame in 0..60 {
+            let angle = frame as f32 * 0.05 + seed as f32;
+            let k = Transform::new(HEAD + Vec3::X * (0.1 * angle.sin()), Quat::from_rotation_y(0.2 * angle.cos()));
+            engine.step(1.0 / 60.0, orbit_camera(HEAD, 3.0, angle), k).unwrap();
+        }
+    }
+    let serial: Vec<u64> = (0..64)
+        .map(|seed| {
+            let mut engine = scene(seed);
+            run(&mut engine, seed);
+            engine.state_hash()
+        })
+        .collect();
+    let mut engines: Vec<Engine> = (0..64).map(scene).collect();
+    std::thread::scope(|threads| {
+        for (worker, chunk) in engines.chunks_mut(16).enumerate() {
+            threads.spawn(move || {
+                for (i, engine) in chunk.iter_mut().enumerate() {
+                    run(engine, worker * 16 + i);
+                }
+            });
+        }
+    });
+    let parallel: Vec<u64> = engines.iter().map(Engine::state_hash).collect();
+    assert_eq!(parallel, serial);
+}

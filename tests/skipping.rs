@@ -5,7 +5,7 @@ mod common;
 
 use common::*;
 use glam::{Quat, Vec3};
-use kodawari::{ChainParams, ColliderDef, ColliderShape, Engine, EngineSettings, Transform};
+use kodawari::{ChainParams, ColliderDef, ColliderShape, Engine, EngineSettings, Transform, step_engines};
 
 const HEAD: Vec3 = Vec3::new(0.0, 1.6, 0.0);
 const CAMERA: Vec3 = Vec3::new(0.0, 1.6, 5.0);
@@ -43,7 +43,9 @@ fn a_settled_chain_sleeps_where_it_would_rest() {
         .map(|(x, y)| (x.position - y.position).length())
         .fold(0.0, f32::max)
         / chain_length(&base);
-    println!("fell asleep after {seconds:.2} s; pose differs from a never-sleeping chain by {difference:.2e} chain lengths");
+    println!(
+        "fell asleep after {seconds:.2} s; pose differs from a never-sleeping chain by {difference:.2e} chain lengths"
+    );
     assert!(difference <= 1e-5, "{difference}");
     let pose = chain_world(&sleeping, a);
     settle(&mut sleeping, 1.0);
@@ -193,4 +195,39 @@ fn engines_step_in_parallel_with_serial_results() {
     });
     let parallel: Vec<u64> = engines.iter().map(Engine::state_hash).collect();
     assert_eq!(parallel, serial);
+}
+
+/// The batch entry point steps many engines with the results of stepping each alone (with or without the
+/// `parallel` feature), and rejects a bad input for any engine before any engine moves.
+#[test]
+fn batch_step_matches_single_steps() {
+    let scene = |seed: usize| {
+        let mut engine = engine_with(EngineSettings::default());
+        let direction = Vec3::new(1.0, -0.2 * seed as f32, 0.3);
+        engine.create_chain(ChainParams::default(), &straight_chain(7, Vec3::ZERO, direction, 0.04)).unwrap();
+        engine
+    };
+    let anchors: Vec<Transform> = (0..16).map(|i| at(HEAD + Vec3::X * i as f32)).collect();
+    let mut alone: Vec<Engine> = (0..16).map(scene).collect();
+    let mut batched: Vec<Engine> = (0..16).map(scene).collect();
+    for frame in 0..30 {
+        let camera = orbit_camera(HEAD, 3.0, frame as f32 * 0.1);
+        for (engine, k) in alone.iter_mut().zip(&anchors) {
+            engine.step(1.0 / 60.0, camera, *k).unwrap();
+        }
+        let mut refs: Vec<&mut Engine> = batched.iter_mut().collect();
+        step_engines(&mut refs, 1.0 / 60.0, camera, &anchors).unwrap();
+    }
+    let hashes = |engines: &[Engine]| engines.iter().map(Engine::state_hash).collect::<Vec<_>>();
+    assert_eq!(hashes(&batched), hashes(&alone));
+
+    let before = hashes(&batched);
+    let mut bad = anchors.clone();
+    bad[9].position.y = f32::NAN;
+    let mut refs: Vec<&mut Engine> = batched.iter_mut().collect();
+    let error = step_engines(&mut refs, 1.0 / 60.0, CAMERA, &bad).unwrap_err();
+    assert!(error.message.contains("engine 9"), "{}", error.message);
+    assert!(step_engines(&mut refs, 1.0 / 60.0, CAMERA, &anchors[..15]).is_err());
+    assert!(step_engines(&mut refs, f32::NAN, CAMERA, &anchors).is_err());
+    assert_eq!(hashes(&batched), before, "a rejected batch moves nothing");
 }

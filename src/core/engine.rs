@@ -12,9 +12,7 @@ use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderS
 use super::collision::ContactInput;
 use super::error::{Error, Result};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
-use super::params::{
-    AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, SLEEP_DELAY, TeleportMode,
-};
+use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, SLEEP_DELAY, TeleportMode};
 use super::rod::{RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
 
@@ -572,7 +570,8 @@ impl Engine {
 
             // Sleeping (SPEC 3.8): skipped while its anchor, rest shape and nearby colliders stay still.
             let colliders_moving = contacts.candidates.iter().any(|&c| {
-                let (first, last) = (&contacts.sweeps[c], &contacts.sweeps[(substeps as usize - 1) * collider_count + c]);
+                let (first, last) =
+                    (&contacts.sweeps[c], &contacts.sweeps[(substeps as usize - 1) * collider_count + c]);
                 first.start.centre != last.end.centre || first.start.rotation != last.end.rotation
             });
             let still = anchor_still && !teleport && !chain.rest_changed && !colliders_moving;
@@ -976,7 +975,7 @@ pub(crate) fn within_world(p: Vec3) -> bool {
     p.is_finite() && p.abs().max_element() <= MAX_COORDINATE
 }
 
-fn validate_step(dt: f32, camera: Vec3, view_reference: &Transform) -> Result<Transform> {
+pub(crate) fn validate_step(dt: f32, camera: Vec3, view_reference: &Transform) -> Result<Transform> {
     if !(dt.is_finite() && dt >= 0.0) {
         return Err(Error::invalid_argument(format!("dt must be finite and >= 0, got {dt}")));
     }

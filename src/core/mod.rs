@@ -6,10 +6,12 @@
 //! - [`blend`]: blending encoded shapes (3.3)
 //! - [`polar`], [`rod`], [`inextensible`]: the oriented-particle rod and its constraints (3.4)
 //! - [`collider`], [`collision`]: colliders and the contact pass (3.7)
+//! - [`batch`]: many engines in one call (optionally on a thread pool)
 //! - [`params`]: settings, parameters, units
 //! - [`arena`], [`chain`], [`engine`]: objects, ids and the stepping loop (3.5, 3.6, 3.9)
 
 pub mod arena;
+pub mod batch;
 pub mod blend;
 pub mod chain;
 pub mod collider;
@@ -25,6 +27,7 @@ pub mod shape;
 pub mod sketch;
 pub mod weights;
 
+pub use batch::step_engines;
 pub use chain::ViewShapeId;
 pub use collider::{ColliderDef, ColliderId, ColliderShape};
 pub use engine::{ChainId, Engine, Stats};

@@ -23,25 +23,84 @@ pub struct ContactInput<'a> {
     pub radii: &'a [f32],
     /// Coulomb friction coefficient.
     pub friction: f32,
+    /// How deep (m) a joint must have been at the start of the substep to count as overlapping since then.
+    /// Joints that the last substep left on a surface are inside or outside it by rounding only; without
+    /// this margin that rounding would decide whether their next push becomes velocity.
+    pub slop: f32,
 }
 
 /// One Gauss-Seidel pass over the contacts. `start` are the positions at the start of the substep, `p` the
 /// current estimate of its end. Particle 0 is kinematic and never moved.
-pub fn collide(start: &[DVec3], p: &mut [DVec3], input: &ContactInput<'_>) -> ContactPass {
+///
+/// A joint that was already inside at the start of the substep is pushed out with `start` moving along, so
+/// the push does not become velocity (see also [`pre_stabilise`]).
+pub fn collide(start: &mut [DVec3], p: &mut [DVec3], input: &ContactInput<'_>) -> ContactPass {
+    collide_at(start, p, input, Pose::End)
+}
+
+/// Which of a sweep's poses the contacts are resolved against.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Pose {
+    /// The end of the substep: the normal case.
+    End,
+    /// The start: pre-stabilisation of the positions the substep starts from.
+    Start,
+}
+
+/// Pre-stabilisation (Macklin et al. 2014, "Unified Particle Physics for Real-Time Applications", 4.4): joints
+/// that start a substep inside a collider (it was created on the chain, it or the chain teleported, the
+/// chain was enabled inside it) are moved out together with the rest of the chain, in position only, with
+/// the colliders at their start pose. Their velocities are untouched, so a deep overlap is resolved without
+/// flinging the chain away at depth / h. `scratch` must hold as many positions as `x`. Returns whether
+/// anything was deeper inside than `settled`.
+pub fn pre_stabilise(
+    x: &mut [DVec3],
+    scratch: &mut [DVec3],
+    input: &ContactInput<'_>,
+    rounds: u32,
+    mut keep_lengths: impl FnMut(&[DVec3], &mut [DVec3]),
+    settled: f32,
+) -> bool {
+    scratch.copy_from_slice(x);
+    let mut pass = collide_at(scratch, x, input, Pose::Start);
+    // Joints left on a surface by the last substep touch it within rounding: only a real overlap needs rounds.
+    if pass.deepest <= settled {
+        return false;
+    }
+    for _ in 1..rounds {
+        keep_lengths(scratch, x);
+        pass = collide_at(scratch, x, input, Pose::Start);
+        if pass.deepest <= settled {
+            break;
+        }
+    }
+    true
+}
+
+fn collide_at(start: &mut [DVec3], p: &mut [DVec3], input: &ContactInput<'_>, pose: Pose) -> ContactPass {
     let mut result = ContactPass { tested: 0, touching: false, deepest: 0.0 };
     for sweep in input.colliders {
         let pass = match sweep.shape {
-            ColliderShape::Plane => collide_plane(start, p, sweep, input),
+            ColliderShape::Plane => collide_plane(start, p, &at(sweep, pose), input),
             ColliderShape::InsideSphere { .. } | ColliderShape::InsideCapsule { .. } => {
-                collide_inside(start, p, sweep, input)
+                collide_inside(start, p, &at(sweep, pose), input)
             }
-            ColliderShape::Sphere { .. } | ColliderShape::Capsule { .. } => collide_outside(start, p, sweep, input),
+            ColliderShape::Sphere { .. } | ColliderShape::Capsule { .. } => {
+                collide_outside(start, p, &at(sweep, pose), input)
+            }
         };
         result.tested += pass.tested;
         result.touching |= pass.touching;
         result.deepest = result.deepest.max(pass.deepest);
     }
     result
+}
+
+fn at(sweep: &ColliderSweep, pose: Pose) -> ColliderSweep {
+    match pose {
+        Pose::End => *sweep,
+        Pose::Start => ColliderSweep { end: sweep.start, ..*sweep },
+    }
 }
 
 /// What a contact pass found.
@@ -55,7 +114,7 @@ pub struct ContactPass {
     pub deepest: f32,
 }
 
-fn collide_plane(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input: &ContactInput<'_>) -> ContactPass {
+fn collide_plane(start: &mut [DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input: &ContactInput<'_>) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
     for j in 1..p.len() {
@@ -63,17 +122,26 @@ fn collide_plane(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input:
         let depth = input.radii[j] - local.y;
         if depth > 0.0 {
             touching = true;
-            deepest = deepest.max(depth);
             let moved = sweep.start.to_local(start[j]);
+            let overlapping_at_start = moved.y < input.radii[j] - input.slop;
+            deepest = deepest.max(depth);
             let correction =
                 Vec3::Y * depth + friction(local + Vec3::Y * depth - moved, Vec3::Y, depth, input.friction);
             p[j] += sweep.end.direction_to_world(correction);
+            if overlapping_at_start {
+                start[j] += sweep.end.direction_to_world(Vec3::Y * depth);
+            }
         }
     }
     ContactPass { tested: p.len() as u64 - 1, touching, deepest }
 }
 
-fn collide_inside(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input: &ContactInput<'_>) -> ContactPass {
+fn collide_inside(
+    start: &mut [DVec3],
+    p: &mut [DVec3],
+    sweep: &ColliderSweep,
+    input: &ContactInput<'_>,
+) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
     let (radius, half_height) = sweep.shape.capsule().expect("inside colliders are capsules");
@@ -85,19 +153,28 @@ fn collide_inside(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input
         let limit = (radius - input.radii[j]).max(0.0);
         if distance > limit {
             touching = true;
-            deepest = deepest.max(distance - limit);
-            let outward = offset / distance;
-            let depth = distance - limit;
             let moved = sweep.start.to_local(start[j]);
-            let normal = -outward;
+            let moved_axis_point = Vec3::new(0.0, moved.y.clamp(-half_height, half_height), 0.0);
+            let overlapping_at_start = (moved - moved_axis_point).length() > limit + input.slop;
+            let depth = distance - limit;
+            deepest = deepest.max(depth);
+            let normal = -offset / distance;
             let correction = normal * depth + friction(local + normal * depth - moved, normal, depth, input.friction);
             p[j] += sweep.end.direction_to_world(correction);
+            if overlapping_at_start {
+                start[j] += sweep.end.direction_to_world(normal * depth);
+            }
         }
     }
     ContactPass { tested: p.len() as u64 - 1, touching, deepest }
 }
 
-fn collide_outside(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input: &ContactInput<'_>) -> ContactPass {
+fn collide_outside(
+    start: &mut [DVec3],
+    p: &mut [DVec3],
+    sweep: &ColliderSweep,
+    input: &ContactInput<'_>,
+) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
     let (radius, half_height) = sweep.shape.capsule().expect("outside colliders are spheres or capsules");
@@ -112,7 +189,9 @@ fn collide_outside(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, inpu
         let point = a.lerp(b, t);
         let reach = radius + input.radii[k] + (input.radii[k + 1] - input.radii[k]) * t;
         let before = sweep.start.to_local(start[k].lerp(start[k + 1], t as f64));
-        let Some((normal, depth)) = contact_outside(before, point, reach, half_height) else {
+        let Some(Contact { normal, depth, overlapping_at_start }) =
+            contact_outside(before, point, reach, half_height, input.slop)
+        else {
             continue;
         };
         touching = true;
@@ -125,6 +204,11 @@ fn collide_outside(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, inpu
         let world = sweep.end.direction_to_world(correction * scale);
         p[k] += world * wa as f64;
         p[k + 1] += world * wb as f64;
+        if overlapping_at_start {
+            let push = sweep.end.direction_to_world(normal * (depth * scale));
+            start[k] += push * wa as f64;
+            start[k + 1] += push * wb as f64;
+        }
     }
     ContactPass { tested: p.len() as u64 - 1, touching, deepest }
 }
@@ -136,14 +220,14 @@ fn collide_outside(start: &[DVec3], p: &mut [DVec3], sweep: &ColliderSweep, inpu
 /// A point still on the side of the axis it came from is pushed out the shortest way. A point that came
 /// from outside and is now past the axis went through: it is put back on the tangent plane where its path
 /// entered, so it ends on the side it came from whatever the step size.
-fn contact_outside(before: Vec3, now: Vec3, reach: f32, half_height: f32) -> Option<(Vec3, f32)> {
+fn contact_outside(before: Vec3, now: Vec3, reach: f32, half_height: f32, slop: f32) -> Option<Contact> {
     let axis_point = |q: Vec3| Vec3::new(0.0, q.y.clamp(-half_height, half_height), 0.0);
     let (from_axis_before, from_axis_now) = (before - axis_point(before), now - axis_point(now));
-    let started_outside = from_axis_before.length_squared() >= reach * reach;
+    let started_outside = from_axis_before.length() >= reach - slop;
     if started_outside && from_axis_before.dot(from_axis_now) <= 0.0 {
         if let Some((entry, normal)) = ray_capsule(before, now, reach, half_height) {
             let depth = (entry - now).dot(normal);
-            return (depth > 0.0).then_some((normal, depth));
+            return (depth > 0.0).then_some(Contact { normal, depth, overlapping_at_start: false });
         }
     }
     let distance = from_axis_now.length();
@@ -152,8 +236,16 @@ fn contact_outside(before: Vec3, now: Vec3, reach: f32, half_height: f32) -> Opt
     }
     // On its own side, or overlapping since the start of the substep (e.g. a collider created inside the
     // chain): out along the shortest way, or any way from the axis itself.
-    let normal = if distance > 1e-12 { from_axis_now / distance } else { fallback_normal(from_axis_before) };
-    Some((normal, reach - distance))
+    let normal = if distance > reach * 1e-6 { from_axis_now / distance } else { fallback_normal(from_axis_before) };
+    Some(Contact { normal, depth: reach - distance, overlapping_at_start: !started_outside })
+}
+
+/// A contact to resolve: push the point `depth` along `normal`.
+struct Contact {
+    normal: Vec3,
+    depth: f32,
+    /// The point was inside already at the start of the substep.
+    overlapping_at_start: bool,
 }
 
 fn fallback_normal(v: Vec3) -> Vec3 {
@@ -170,7 +262,7 @@ fn friction(motion: Vec3, normal: Vec3, depth: f32, coefficient: f32) -> Vec3 {
     }
     let tangential = motion - normal * motion.dot(normal);
     let length = tangential.length();
-    if length <= 1e-12 {
+    if length <= 0.0 {
         return Vec3::ZERO;
     }
     -tangential * (coefficient * depth / length).min(1.0)
@@ -186,9 +278,11 @@ fn ray_capsule(from: Vec3, to: Vec3, radius: f32, half_height: f32) -> Option<(V
             best = Some((u, normal));
         }
     };
+    // Relative to the radius, so that results do not depend on the engine's scale.
+    let negligible = (radius * 1e-6).powi(2);
     // The cylinder between the caps.
     let a = d.x * d.x + d.z * d.z;
-    if a > 1e-12 {
+    if a > negligible {
         let b = from.x * d.x + from.z * d.z;
         let c = from.x * from.x + from.z * from.z - radius * radius;
         let disc = b * b - a * c;
@@ -202,7 +296,7 @@ fn ray_capsule(from: Vec3, to: Vec3, radius: f32, half_height: f32) -> Option<(V
     }
     // The two caps (one when the capsule is a sphere).
     let a = d.length_squared();
-    if a > 1e-12 {
+    if a > negligible {
         for centre_y in if half_height > 0.0 { [-half_height, half_height] } else { [0.0, 0.0] } {
             let centre = Vec3::new(0.0, centre_y, 0.0);
             let oc = from - centre;
@@ -224,20 +318,21 @@ fn closest_between_segments(p: (Vec3, Vec3), q: (Vec3, Vec3)) -> (f32, f32) {
     let (d1, d2) = (p.1 - p.0, q.1 - q.0);
     let r = p.0 - q.0;
     let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
-    const EPS: f32 = 1e-12;
-    if a <= EPS && e <= EPS {
+    // Degenerate (point) segments and parallel ones, judged relative to the segments' own lengths so that
+    // the result does not depend on the engine's scale.
+    if a <= 0.0 && e <= 0.0 {
         return (0.0, 0.0);
     }
-    if a <= EPS {
+    if a <= 0.0 {
         return (0.0, (f / e).clamp(0.0, 1.0));
     }
     let c = d1.dot(r);
-    if e <= EPS {
+    if e <= 0.0 {
         return ((-c / a).clamp(0.0, 1.0), 0.0);
     }
     let b = d1.dot(d2);
     let denom = a * e - b * b;
-    let mut s = if denom > EPS { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+    let mut s = if denom > 1e-10 * a * e { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
     let mut t = (b * s + f) / e;
     if t < 0.0 {
         t = 0.0;
@@ -282,18 +377,20 @@ mod tests {
     #[test]
     fn point_that_passed_through_goes_back_to_its_side() {
         // From the left of a sphere of reach 0.5 straight through to the right: back onto the left surface.
-        let (normal, depth) = contact_outside(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.7, 0.0, 0.0), 0.5, 0.0).unwrap();
+        let Contact { normal, depth, overlapping_at_start } =
+            contact_outside(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.7, 0.0, 0.0), 0.5, 0.0, 0.0).unwrap();
+        assert!(!overlapping_at_start);
         assert!((normal + Vec3::X).length() < 1e-6 && (depth - 1.2).abs() < 1e-6, "{normal} {depth}");
     }
 
     #[test]
     fn segment_across_a_sphere_is_pushed_out_at_its_middle() {
         // A segment whose ends are both outside a sphere but whose middle passes through it.
-        let start = [DVec3::new(-1.0, 0.5, 0.0), DVec3::new(-0.5, 0.5, 0.0), DVec3::new(0.5, 0.5, 0.0)];
+        let mut start = [DVec3::new(-1.0, 0.5, 0.0), DVec3::new(-0.5, 0.5, 0.0), DVec3::new(0.5, 0.5, 0.0)];
         let mut p = [DVec3::new(-1.0, 0.2, 0.0), DVec3::new(-0.5, 0.2, 0.0), DVec3::new(0.5, 0.2, 0.0)];
         let sweep = still(ColliderShape::Sphere { radius: 0.4 });
-        let input = ContactInput { colliders: &[sweep], radii: &[0.0; 3], friction: 0.0 };
-        collide(&start, &mut p, &input);
+        let input = ContactInput { colliders: &[sweep], radii: &[0.0; 3], friction: 0.0, slop: 0.0 };
+        collide(&mut start, &mut p, &input);
         let (a, b) = (p[1].as_vec3(), p[2].as_vec3());
         let (t, _) = closest_between_segments((a, b), (Vec3::ZERO, Vec3::ZERO));
         let distance = a.lerp(b, t).length();
@@ -304,23 +401,23 @@ mod tests {
     #[test]
     fn plane_friction_stops_slow_sliding_and_not_fast() {
         let plane = still(ColliderShape::Plane);
-        let start = [DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0)];
+        let mut start = [DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0)];
         // Pressed 0.1 into the plane while sliding 0.05 sideways: friction 1 holds it (0.05 < 1 * 0.1).
         let mut p = [DVec3::ZERO, DVec3::new(1.05, -0.1, 0.0)];
-        collide(&start, &mut p, &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0 });
+        collide(&mut start, &mut p, &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0, slop: 0.0 });
         assert!((p[1] - DVec3::new(1.0, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
         // Sliding 0.5: friction removes 0.1 of it.
         let mut p = [DVec3::ZERO, DVec3::new(1.5, -0.1, 0.0)];
-        collide(&start, &mut p, &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0 });
+        collide(&mut start, &mut p, &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0, slop: 0.0 });
         assert!((p[1] - DVec3::new(1.4, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
     }
 
     #[test]
     fn inside_sphere_keeps_particles_within_radius_minus_their_own() {
         let sweep = still(ColliderShape::InsideSphere { radius: 1.0 });
-        let start = [DVec3::ZERO, DVec3::new(0.5, 0.0, 0.0)];
+        let mut start = [DVec3::ZERO, DVec3::new(0.5, 0.0, 0.0)];
         let mut p = [DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0)];
-        collide(&start, &mut p, &ContactInput { colliders: &[sweep], radii: &[0.1; 2], friction: 0.0 });
+        collide(&mut start, &mut p, &ContactInput { colliders: &[sweep], radii: &[0.1; 2], friction: 0.0, slop: 0.0 });
         assert!((p[1] - DVec3::new(0.9, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
     }
 }

@@ -40,6 +40,10 @@ pub struct Stats {
     pub contact_pairs_tested: u64,
 }
 
+/// Share of a chain's shortest segment a joint must have been inside a collider at the start of a substep to
+/// count as overlapping since then (see [`ContactInput::slop`]).
+const CONTACT_SLOP: f32 = 1e-3;
+
 /// Salts ids so that an id from one engine is rejected by another. Only distinguishes engines; it never
 /// influences simulation results, so it is the one piece of process-wide state the library keeps.
 static NEXT_SALT: AtomicU16 = AtomicU16::new(1);
@@ -584,6 +588,7 @@ impl Engine {
             }
 
             let params = chain.params;
+            let slop = CONTACT_SLOP * chain.frame.lengths.iter().copied().fold(f32::INFINITY, f32::min);
             let alpha = params.alpha_per_iteration(h as f32, iterations);
             let decay = (-params.damping * h as f32).exp();
             let suppression_share = params.momentum_suppression * params.alpha_per_substep(h as f32);
@@ -625,6 +630,7 @@ impl Engine {
                         colliders: &contacts.chain_sweeps,
                         radii: &contacts.radii,
                         friction: params.friction,
+                        slop,
                     }),
                 };
                 let report = substep(&mut chain.state, &chain.frame.lengths, &input, &mut self.scratch);

@@ -4,7 +4,7 @@
 
 use glam::{DVec3, Mat3, Quat, Vec3};
 
-use super::collision::{ContactInput, collide};
+use super::collision::{ContactInput, collide, pre_stabilise};
 use super::inextensible::{self, ConstraintScratch};
 use super::math::{Transform, align_hemisphere, nlerp_shorter};
 use super::polar::extract_rotation;
@@ -147,7 +147,14 @@ pub fn substep(
     let n = state.x.len();
     scratch.reserve(n);
     let h = input.h;
-    let RodScratch { p, qp, constraints, .. } = scratch;
+    let RodScratch { p, qp, p_old, constraints } = scratch;
+    let settled = CONTACT_SETTLED * lengths.iter().copied().fold(f32::INFINITY, f32::min);
+    if let Some(contacts) = &input.contacts {
+        let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
+            inextensible::solve(previous, x, lengths, input.inv_mass, constraints);
+        };
+        pre_stabilise(&mut state.x, &mut p_old[..n], contacts, FINAL_CONTACT_ROUNDS, keep_lengths, settled);
+    }
     let (p, qp) = (&mut p[..n], &mut qp[..n]);
 
     // Kinematic root.
@@ -175,18 +182,17 @@ pub fn substep(
         }
         report.fallback |= !inextensible::solve(&state.x, p, lengths, input.inv_mass, constraints);
         if let Some(contacts) = &input.contacts {
-            let mut pass = collide(&state.x, p, contacts);
+            let mut pass = collide(&mut state.x, p, contacts);
             report.contact_pairs += pass.tested;
             // A collider pushing hard (a swinging arm) moves a few particles far in one substep; the rest of
             // the chain follows through more rounds of lengths then contacts. The substep ends on contacts.
             if iteration + 1 == iterations {
-                let settled = CONTACT_SETTLED * lengths.iter().copied().fold(f32::INFINITY, f32::min);
                 for _ in 1..FINAL_CONTACT_ROUNDS {
                     if !pass.touching || pass.deepest <= settled {
                         break;
                     }
                     report.fallback |= !inextensible::solve(&state.x, p, lengths, input.inv_mass, constraints);
-                    pass = collide(&state.x, p, contacts);
+                    pass = collide(&mut state.x, p, contacts);
                     report.contact_pairs += pass.tested;
                 }
             }

@@ -101,7 +101,9 @@ impl EngineSettings {
         check(self.teleport_angle > 0.0 && self.teleport_angle.is_finite(), || {
             format!("teleport_angle {} must be finite and > 0", self.teleport_angle)
         })?;
-        check((0.0..=1e6).contains(&self.sleep_speed), || format!("sleep_speed {} outside [0, 1e6]", self.sleep_speed))?;
+        check((0.0..=1e6).contains(&self.sleep_speed), || {
+            format!("sleep_speed {} outside [0, 1e6]", self.sleep_speed)
+        })?;
         check(self.lod <= MAX_LOD, || format!("lod {} outside [0, {MAX_LOD}]", self.lod))?;
         check((MIN_SCALE..=MAX_SCALE).contains(&self.scale), || {
             format!("scale {} outside [{MIN_SCALE}, {MAX_SCALE}]", self.scale)

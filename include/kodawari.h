@@ -63,6 +63,33 @@
 // One per character: owns chains and view shapes, gravity and solver settings. Opaque.
 typedef struct kdw_engine kdw_engine;
 
+// Result of every fallible call: 0 is success, negative values are errors (`KDW_STATUS_*`). Kept a plain
+// integer so that an unknown value coming back from C is never undefined behaviour.
+typedef int32_t kdw_status;
+
+// A 3D vector, the layout of Unity's `Vector3`.
+typedef struct kdw_vec3 {
+    float x;
+    float y;
+    float z;
+} kdw_vec3;
+
+// A rotation quaternion (x, y, z, w), the layout of Unity's `Quaternion`. Need not be unit: it is
+// normalised on the way in; a null quaternion is rejected.
+typedef struct kdw_quat {
+    float x;
+    float y;
+    float z;
+    float w;
+} kdw_quat;
+
+// Position + rotation: 28 bytes, the layout of a Unity `Vector3` followed by a `Quaternion`. Positions
+// must be finite and within ±1e9 m.
+typedef struct kdw_transform {
+    struct kdw_vec3 position;
+    struct kdw_quat rotation;
+} kdw_transform;
+
 // Chain parameters; obtain defaults from `kdw_chain_def_default()`.
 typedef struct kdw_chain_def {
     // `sizeof(kdw_chain_def)`.
@@ -92,33 +119,6 @@ typedef struct kdw_chain_def {
     // Coulomb friction against colliders, in [0, 10]. Default 0.3.
     float friction;
 } kdw_chain_def;
-
-// Result of every fallible call: 0 is success, negative values are errors (`KDW_STATUS_*`). Kept a plain
-// integer so that an unknown value coming back from C is never undefined behaviour.
-typedef int32_t kdw_status;
-
-// A 3D vector, the layout of Unity's `Vector3`.
-typedef struct kdw_vec3 {
-    float x;
-    float y;
-    float z;
-} kdw_vec3;
-
-// A rotation quaternion (x, y, z, w), the layout of Unity's `Quaternion`. Need not be unit: it is
-// normalised on the way in; a null quaternion is rejected.
-typedef struct kdw_quat {
-    float x;
-    float y;
-    float z;
-    float w;
-} kdw_quat;
-
-// Position + rotation: 28 bytes, the layout of a Unity `Vector3` followed by a `Quaternion`. Positions
-// must be finite and within ±1e9 m.
-typedef struct kdw_transform {
-    struct kdw_vec3 position;
-    struct kdw_quat rotation;
-} kdw_transform;
 
 // A chain (`ViewDependentPhysicalObject`). Index + generation + owner; 0 is the null id.
 typedef uint64_t kdw_chain_id;
@@ -167,7 +167,7 @@ typedef struct kdw_engine_def {
     uint32_t teleport_mode;
     // A chain whose joints all move slower than this relative to its root (character units/s, × `scale`)
     // for 0.5 s, under a still anchor, rest shape and colliders, sleeps until any of them changes. In
-    // [0, 1e6]; 0 never sleeps. Default 1e-4.
+    // [0, 1e6]; 0 never sleeps. Default 5e-6 (falls asleep within 1e-5 chain lengths of its resting pose).
     float sleep_speed;
     // Level of detail for distant characters, in [0, 3]: each level halves the internal step rate (not
     // below 30 Hz) and the iterations (not below 1). Default 0.
@@ -268,6 +268,18 @@ typedef uint64_t kdw_view_shape_id;
 extern "C" {
 #endif // __cplusplus
 
+// Steps `count` distinct engines by `dt` with one camera, engine i with its view reference
+// `view_references[i]` (as `kdw_engine_step` each). Built with the `parallel` feature, the engines are
+// stepped on a small thread pool; otherwise one after the other (the Unity package ships without it:
+// Unity hosts step from their own jobs). Every handle and input is checked before any engine moves: a NULL,
+// poisoned or repeated handle, or any bad input, fails the whole call and changes nothing. A panic while
+// stepping poisons every engine of the call.
+kdw_status kdw_engines_step(struct kdw_engine *const *engines,
+                            uint32_t count,
+                            float dt,
+                            const struct kdw_vec3 *camera_position,
+                            const struct kdw_transform *view_references);
+
 // Default chain parameters (stiffness 0.5, damping 1/s, full momentum suppression, anchored to the view
 // reference).
 struct kdw_chain_def kdw_chain_def_default(void);
@@ -335,6 +347,17 @@ kdw_status kdw_chain_set_joint_radii(struct kdw_engine *engine,
 
 // The chain treats its anchor's motion in the next step as a teleport (the engine's `teleport_mode`).
 kdw_status kdw_chain_teleport(struct kdw_engine *engine, kdw_chain_id chain);
+
+// Enables (1) or disables (0) a chain. A disabled (culled) chain is not simulated and costs nothing; it
+// follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip.
+kdw_status kdw_chain_set_enabled(struct kdw_engine *engine, kdw_chain_id chain, uint32_t enabled);
+
+// `*out_enabled` = 1 if the chain is enabled, else 0.
+kdw_status kdw_chain_is_enabled(const struct kdw_engine *engine, kdw_chain_id chain, uint32_t *out_enabled);
+
+// `*out_asleep` = 1 if the chain slept through the last step (its anchor, rest shape and nearby colliders
+// were still and its motion had died out), else 0.
+kdw_status kdw_chain_is_asleep(const struct kdw_engine *engine, kdw_chain_id chain, uint32_t *out_asleep);
 
 // Default collider: a sphere of radius 0.1 m at the origin on layer 1.
 struct kdw_collider_def kdw_collider_def_default(void);

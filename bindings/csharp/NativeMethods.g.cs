@@ -26,6 +26,17 @@ namespace Kodawari.Native
 
 
         /// <summary>
+        ///  Steps `count` distinct engines by `dt` with one camera, engine i with its view reference
+        ///  `view_references[i]` (as `kdw_engine_step` each). Built with the `parallel` feature, the engines are
+        ///  stepped on a small thread pool; otherwise one after the other (the Unity package ships without it:
+        ///  Unity hosts step from their own jobs). Every handle and input is checked before any engine moves: a NULL,
+        ///  poisoned or repeated handle, or any bad input, fails the whole call and changes nothing. A panic while
+        ///  stepping poisons every engine of the call.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_engines_step", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_engines_step(kdw_engine** engines, uint count, float dt, kdw_vec3* camera_position, kdw_transform* view_references);
+
+        /// <summary>
         ///  Default chain parameters (stiffness 0.5, damping 1/s, full momentum suppression, anchored to the view
         ///  reference).
         /// </summary>
@@ -114,6 +125,26 @@ namespace Kodawari.Native
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_chain_teleport", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
         internal static extern int kdw_chain_teleport(kdw_engine* engine, ulong chain);
+
+        /// <summary>
+        ///  Enables (1) or disables (0) a chain. A disabled (culled) chain is not simulated and costs nothing; it
+        ///  follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_chain_set_enabled", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_chain_set_enabled(kdw_engine* engine, ulong chain, uint enabled);
+
+        /// <summary>
+        ///  `*out_enabled` = 1 if the chain is enabled, else 0.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_chain_is_enabled", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_chain_is_enabled(kdw_engine* engine, ulong chain, uint* out_enabled);
+
+        /// <summary>
+        ///  `*out_asleep` = 1 if the chain slept through the last step (its anchor, rest shape and nearby colliders
+        ///  were still and its motion had died out), else 0.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_chain_is_asleep", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_chain_is_asleep(kdw_engine* engine, ulong chain, uint* out_asleep);
 
         /// <summary>
         ///  Default collider: a sphere of radius 0.1 m at the origin on layer 1.
@@ -564,7 +595,7 @@ namespace Kodawari.Native
         /// <summary>
         ///  A chain whose joints all move slower than this relative to its root (character units/s, × `scale`)
         ///  for 0.5 s, under a still anchor, rest shape and colliders, sleeps until any of them changes. In
-        ///  [0, 1e6]; 0 never sleeps. Default 1e-4.
+        ///  [0, 1e6]; 0 never sleeps. Default 5e-6 (falls asleep within 1e-5 chain lengths of its resting pose).
         /// </summary>
         public float sleep_speed;
         /// <summary>

@@ -186,3 +186,37 @@ pub extern "C" fn kdw_chain_teleport(engine: *mut kdw_engine, chain: kdw_chain_i
     // SAFETY: live engine handle, this thread only.
     guard(|| unsafe { with_engine_mut(engine, |e| Ok(e.teleport_chain(ChainId::from_bits(chain))?)) })
 }
+
+/// Enables (1) or disables (0) a chain. A disabled (culled) chain is not simulated and costs nothing; it
+/// follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_chain_set_enabled(engine: *mut kdw_engine, chain: kdw_chain_id, enabled: u32) -> kdw_status {
+    guard(|| {
+        if enabled > 1 {
+            return Err(crate::core::Error::invalid_argument(format!("enabled must be 0 or 1, got {enabled}")).into());
+        }
+        // SAFETY: live engine handle, this thread only.
+        unsafe { with_engine_mut(engine, |e| Ok(e.set_chain_enabled(ChainId::from_bits(chain), enabled == 1)?)) }
+    })
+}
+
+/// `*out_enabled` = 1 if the chain is enabled, else 0.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_chain_is_enabled(
+    engine: *const kdw_engine,
+    chain: kdw_chain_id,
+    out_enabled: *mut u32,
+) -> kdw_status {
+    query(engine, out_enabled, "out_enabled", |e| Ok(e.is_chain_enabled(ChainId::from_bits(chain))? as u32))
+}
+
+/// `*out_asleep` = 1 if the chain slept through the last step (its anchor, rest shape and nearby colliders
+/// were still and its motion had died out), else 0.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_chain_is_asleep(
+    engine: *const kdw_engine,
+    chain: kdw_chain_id,
+    out_asleep: *mut u32,
+) -> kdw_status {
+    query(engine, out_asleep, "out_asleep", |e| Ok(e.is_chain_asleep(ChainId::from_bits(chain))? as u32))
+}

@@ -95,6 +95,13 @@ pub(crate) struct EngineBox {
     pub poisoned: bool,
 }
 
+/// Marks engines whose step panicked part way (a batch call cannot tell which one did).
+pub(crate) fn poison_all(boxes: &mut [&mut EngineBox]) {
+    for b in boxes {
+        b.poisoned = true;
+    }
+}
+
 fn poisoned_error() -> FfiError {
     FfiError::new(KDW_STATUS_PANIC, "the engine was poisoned by an earlier internal error; destroy it")
 }

@@ -3,7 +3,7 @@
 //! - [`types`]: plain C structs (vectors, transforms, ids) and their conversions to core types
 //! - [`status`]: `kdw_status`, its strings, the thread-local error message
 //! - [`guard`]: the panic guard and the pointer checks every exported body goes through
-//! - one module per C concept: [`engine`], [`chain`], [`collider`], [`view_shape`], [`version`]
+//! - one module per C concept: [`engine`], [`batch`], [`chain`], [`collider`], [`view_shape`], [`version`]
 
 #![allow(non_camel_case_types)]
 // C names, exactly as in the header.
@@ -12,6 +12,7 @@
 // header. Rust code reaches them only from tests.
 #![allow(clippy::not_unsafe_ptr_arg_deref)]
 
+pub mod batch;
 pub mod chain;
 pub mod collider;
 pub mod engine;

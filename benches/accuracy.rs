@@ -268,14 +268,14 @@ fn pendulum_run(reference: &PendulumReference, fps: u32, settings: EngineSetting
     context(format!(
         "{}, {fps} fps, {} Hz, {} it",
         pendulum_name(reference.joints),
-        settings.substep_rate,
-        settings.iterations
+        settings.effective_substep_rate(),
+        settings.effective_iterations()
     ));
     let mut engine = Engine::new(settings).unwrap();
     let base = reference.base();
     let lengths = lengths_of(&base);
     let id = engine.create_chain(limp(), &base).unwrap();
-    let h = 1.0 / settings.substep_rate as f64;
+    let h = 1.0 / settings.effective_substep_rate() as f64;
     let frames = (PENDULUM_SECONDS * fps as f64).round() as u32;
     let (mut physics, mut seen, mut worst, mut worst_stretch, mut count) = (0.0, 0.0, 0.0f64, 0.0f64, 0usize);
     for k in 1..=frames {
@@ -366,6 +366,44 @@ fn pendulums(report: &mut Report, references: &[PendulumReference]) {
                     );
                 }
                 report.figure(&name, "RMS joint error / length, 60 fps, as seen (t)", e.seen_rms, Some(cost), None);
+            }
+        }
+    }
+    report.section(text);
+}
+
+/// What each level of detail (`EngineSettings::lod`) costs in accuracy and saves in time, on the pendulums at
+/// 60 fps (SPEC 3.8: distant characters).
+fn level_of_detail(report: &mut Report, references: &[PendulumReference]) {
+    let mut text = String::from(
+        "## Level of detail
+
+`EngineSettings::lod` halves the internal step rate (not below 30 Hz) and the iterations (not below 1) per level, for distant characters. Same pendulum runs as above at 60 fps: RMS joint error / chain length (physics, t - h) and wall time per simulated second, with the ratio to level 0.
+
+| scenario | lod | internal rate | iterations | RMS physics | max stretch | wall s / sim s | time vs lod 0 |
+|---|---|---|---|---|---|---|---|
+",
+    );
+    for reference in references.iter().filter(|r| r.joints > 2) {
+        let name = pendulum_name(reference.joints);
+        let mut base_cost = None;
+        for lod in 0..=3u32 {
+            let settings = EngineSettings { lod, ..Default::default() };
+            let e = pendulum_run(reference, 60, settings);
+            let cost = wall_per_sim_second(PENDULUM_SECONDS, || pendulum_timed(reference, 60, settings));
+            let base = *base_cost.get_or_insert(cost);
+            let _ = writeln!(
+                text,
+                "| {name} | {lod} | {} Hz | {} | {:.2e} | {:.1e} | {cost:.2e} | {:.2} |",
+                settings.effective_substep_rate(),
+                settings.effective_iterations(),
+                e.physics_rms,
+                e.stretch,
+                cost / base
+            );
+            // At level 3 (30 Hz) the 60 fps frames fall between internal states: not a swept-settings figure.
+            if lod <= 2 {
+                report.stretch_swept(&format!("{name}, 60 fps, lod {lod}"), e.stretch, lod == 0);
             }
         }
     }
@@ -1137,6 +1175,7 @@ fn main() {
     println!("kodawari accuracy benchmark (SPEC 6.1). Building the exact pendulum references...");
     let references: Vec<PendulumReference> = [2usize, 3, 9].into_iter().map(PendulumReference::new).collect();
     pendulums(&mut report, &references);
+    level_of_detail(&mut report, &references);
     frame_rate_invariance(&mut report);
     settled_shapes(&mut report);
     galilean(&mut report);

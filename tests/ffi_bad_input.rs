@@ -17,7 +17,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::ffi::{CStr, c_char};
 use std::ptr::{null, null_mut};
 
+use kodawari::ffi::batch::*;
 use kodawari::ffi::chain::*;
+use kodawari::ffi::collider::*;
 use kodawari::ffi::engine::*;
 use kodawari::ffi::sketch::*;
 use kodawari::ffi::status::*;
@@ -102,7 +104,8 @@ fn parse_functions(text: &str) -> Vec<Function> {
     functions
 }
 
-/// Float fields of the def structs (`struct_name -> [field]`), vec3 fields expanded to `field.x` etc.
+/// Float fields of the def structs (`struct_name -> [field]`), vec3 fields expanded to `field.x` etc. and
+/// transform fields to `field.position.x` ... `field.rotation.w`.
 fn struct_float_fields(text: &str) -> BTreeMap<String, Vec<String>> {
     let clean = strip(text);
     let mut map = BTreeMap::new();
@@ -126,6 +129,9 @@ fn struct_float_fields(text: &str) -> BTreeMap<String, Vec<String>> {
                 fields.push(id);
             } else if field.starts_with("struct kdw_vec3 ") {
                 fields.extend(["x", "y", "z"].map(|c| format!("{id}.{c}")));
+            } else if field.starts_with("struct kdw_transform ") {
+                fields.extend(["position.x", "position.y", "position.z"].map(|c| format!("{id}.{c}")));
+                fields.extend(["rotation.x", "rotation.y", "rotation.z", "rotation.w"].map(|c| format!("{id}.{c}")));
             }
         }
         map.insert(name, fields);
@@ -151,7 +157,7 @@ fn required_tags(f: &Function, floats: &BTreeMap<String, Vec<String>>) -> BTreeS
                 tags.insert(format!("{v}:{n}"));
             }
         }
-        if p.ty == "kdw_chain_id" || p.ty == "kdw_view_shape_id" {
+        if p.ty == "kdw_chain_id" || p.ty == "kdw_view_shape_id" || p.ty == "kdw_collider_id" {
             for v in ["zero", "stale", "foreign", "kind"] {
                 tags.insert(format!("{v}:{n}"));
             }
@@ -194,8 +200,14 @@ struct Fixture {
     stale_view: u64,
     foreign_chain: u64,
     foreign_view: u64,
+    /// Colliders of `a`: a sphere and a capsule out of the chains' reach (2 m to the side), so that they are
+    /// part of the state every rejected call must leave alone without changing what the chains do.
+    collider: u64,
+    stale_collider: u64,
+    foreign_collider: u64,
     joint_total: u32,
     chain_total: u32,
+    collider_total: u32,
 }
 
 fn ok(status: kdw_status, what: &str) {
@@ -246,6 +258,26 @@ fn new_chain(engine: *mut kdw_engine, n: u32) -> u64 {
     id
 }
 
+/// A valid collider def of `shape`, posed out of the fixture chains' reach.
+fn collider_def(shape: u32, radius: f32, half_height: f32) -> kdw_collider_def {
+    let transform = kdw_transform { position: vec3(2.0, 1.4, 0.0), ..head() };
+    kdw_collider_def { shape, radius, half_height, transform, ..kdw_collider_def_default() }
+}
+
+fn new_collider(engine: *mut kdw_engine, def: &kdw_collider_def) -> u64 {
+    let mut id = 0;
+    ok(kdw_collider_create(engine, def, &mut id), "create collider");
+    id
+}
+
+/// Valid poses for the fixture's two colliders (one entry per collider, creation order).
+fn collider_poses() -> [kdw_transform; 2] {
+    [
+        kdw_transform { position: vec3(2.0, 1.4, 0.0), ..head() },
+        kdw_transform { position: vec3(-2.0, 1.4, 0.0), ..head() },
+    ]
+}
+
 fn new_view(engine: *mut kdw_engine, chain: u64, n: u32) -> u64 {
     let shape = joints(n, 1.0);
     let mut id = 0;
@@ -267,6 +299,12 @@ impl Fixture {
         ok(kdw_chain_destroy(a, stale_chain), "destroy chain");
         let foreign_chain = new_chain(b, N);
         let foreign_view = new_view(b, foreign_chain, N);
+        let collider = new_collider(a, &collider_def(KDW_COLLIDER_SPHERE, 0.1, 0.0));
+        let stale_collider = new_collider(a, &collider_def(KDW_COLLIDER_SPHERE, 0.2, 0.0));
+        new_collider(a, &collider_def(KDW_COLLIDER_CAPSULE, 0.05, 0.1));
+        ok(kdw_collider_destroy(a, stale_collider), "destroy collider");
+        let foreign_collider = new_collider(b, &collider_def(KDW_COLLIDER_SPHERE, 0.1, 0.0));
+        ok(kdw_engine_set_collider_transforms(a, collider_poses().as_ptr(), 2), "move colliders");
         for _ in 0..10 {
             ok(kdw_engine_step(a, 1.0 / 60.0, &camera(), &head()), "step a");
             ok(kdw_engine_step(b, 1.0 / 60.0, &camera(), &head()), "step b");
@@ -280,8 +318,12 @@ impl Fixture {
             stale_view,
             foreign_chain,
             foreign_view,
+            collider,
+            stale_collider,
+            foreign_collider,
             joint_total: 2 * N,
             chain_total: 2,
+            collider_total: 2,
         }
     }
 
@@ -292,13 +334,35 @@ impl Fixture {
         (ha, hb)
     }
 
-    /// The four bad chain ids.
-    fn bad_chain_ids(&self) -> [(&'static str, u64); 4] {
-        [("zero", 0), ("stale", self.stale_chain), ("foreign", self.foreign_chain), ("kind", self.view)]
+    /// The bad chain ids: null, stale, foreign, and ids of the other kinds (a view shape's, a collider's).
+    fn bad_chain_ids(&self) -> [(&'static str, u64); 5] {
+        [
+            ("zero", 0),
+            ("stale", self.stale_chain),
+            ("foreign", self.foreign_chain),
+            ("kind", self.view),
+            ("kind", self.collider),
+        ]
     }
 
-    fn bad_view_ids(&self) -> [(&'static str, u64); 4] {
-        [("zero", 0), ("stale", self.stale_view), ("foreign", self.foreign_view), ("kind", self.chain)]
+    fn bad_view_ids(&self) -> [(&'static str, u64); 5] {
+        [
+            ("zero", 0),
+            ("stale", self.stale_view),
+            ("foreign", self.foreign_view),
+            ("kind", self.chain),
+            ("kind", self.collider),
+        ]
+    }
+
+    fn bad_collider_ids(&self) -> [(&'static str, u64); 5] {
+        [
+            ("zero", 0),
+            ("stale", self.stale_collider),
+            ("foreign", self.foreign_collider),
+            ("kind", self.chain),
+            ("kind", self.view),
+        ]
     }
 }
 
@@ -354,34 +418,24 @@ fn sentinel_quat() -> kdw_quat {
     kdw_quat { x: SENTINEL_F, y: SENTINEL_F, z: SENTINEL_F, w: SENTINEL_F }
 }
 
-fn sentinel_engine_def() -> kdw_engine_def {
-    kdw_engine_def {
-        struct_size: SENTINEL_U32,
-        gravity: vec3(SENTINEL_F, SENTINEL_F, SENTINEL_F),
-        substep_rate: SENTINEL_F,
-        max_substeps: SENTINEL_U32,
-        iterations: SENTINEL_U32,
-        time_scale: SENTINEL_F,
-        teleport_distance: SENTINEL_F,
-        teleport_angle: SENTINEL_F,
-        teleport_mode: SENTINEL_U32,
-        scale: SENTINEL_F,
+/// A value of `T` whose every byte is 0xA5: a sentinel that covers every field, including ones added to the
+/// def structs later. Only for the plain C structs here, whose fields are u32 / f32 (any bit pattern is valid;
+/// 0xA5A5A5A5 is an ordinary finite float, so `==` compares it reliably).
+fn sentinel_bytes<T: Copy>() -> T {
+    // SAFETY: `T` is one of the padding-free `kdw_*` structs of u32 and f32 fields, valid for any bit pattern.
+    unsafe {
+        let mut value = std::mem::MaybeUninit::<T>::uninit();
+        std::ptr::write_bytes(value.as_mut_ptr(), 0xA5, 1);
+        value.assume_init()
     }
 }
 
+fn sentinel_engine_def() -> kdw_engine_def {
+    sentinel_bytes()
+}
+
 fn sentinel_chain_def() -> kdw_chain_def {
-    kdw_chain_def {
-        struct_size: SENTINEL_U32,
-        stiffness: SENTINEL_F,
-        damping: SENTINEL_F,
-        momentum_suppression: SENTINEL_F,
-        mass: SENTINEL_F,
-        radius: SENTINEL_F,
-        gravity_scale: SENTINEL_F,
-        anchor: SENTINEL_U32,
-        collision_mask: SENTINEL_U32,
-        friction: SENTINEL_F,
-    }
+    sentinel_bytes()
 }
 
 const BAD_FLOATS: [(&str, f32); 3] = [("nan", f32::NAN), ("inf", f32::INFINITY), ("-inf", f32::NEG_INFINITY)];
@@ -453,7 +507,7 @@ fn engine_def_variants() -> Vec<(String, kdw_engine_def, kdw_status)> {
     for size in [0u32, d.struct_size - 4, d.struct_size + 4, u32::MAX] {
         out.push(("struct_size:{}".into(), kdw_engine_def { struct_size: size, ..d }, KDW_STATUS_STRUCT_SIZE_MISMATCH));
     }
-    let fields: [(&str, fn(&mut kdw_engine_def, f32)); 8] = [
+    let fields: [(&str, fn(&mut kdw_engine_def, f32)); 10] = [
         ("gravity.x", |d, v| d.gravity.x = v),
         ("gravity.y", |d, v| d.gravity.y = v),
         ("gravity.z", |d, v| d.gravity.z = v),
@@ -461,6 +515,8 @@ fn engine_def_variants() -> Vec<(String, kdw_engine_def, kdw_status)> {
         ("time_scale", |d, v| d.time_scale = v),
         ("teleport_distance", |d, v| d.teleport_distance = v),
         ("teleport_angle", |d, v| d.teleport_angle = v),
+        ("scale", |d, v| d.scale = v),
+        ("sleep_speed", |d, v| d.sleep_speed = v),
         ("substep_rate", |d, v| d.substep_rate = v * 0.0 + if v.is_nan() { 29.0 } else { 10001.0 }),
     ];
     for (field, set) in fields {
@@ -471,7 +527,7 @@ fn engine_def_variants() -> Vec<(String, kdw_engine_def, kdw_status)> {
         }
     }
     // Out of the documented ranges.
-    let ranged: [(&str, kdw_engine_def); 10] = [
+    let ranged: [(&str, kdw_engine_def); 18] = [
         ("huge", kdw_engine_def { substep_rate: 1e30, ..d }),
         ("range", kdw_engine_def { substep_rate: 0.0, ..d }),
         ("range", kdw_engine_def { max_substeps: 0, ..d }),
@@ -482,6 +538,14 @@ fn engine_def_variants() -> Vec<(String, kdw_engine_def, kdw_status)> {
         ("range", kdw_engine_def { time_scale: -1.0, ..d }),
         ("huge", kdw_engine_def { teleport_distance: -1e30, ..d }),
         ("huge", kdw_engine_def { teleport_angle: -1e30, ..d }),
+        ("range", kdw_engine_def { teleport_mode: 2, ..d }),
+        ("range", kdw_engine_def { teleport_mode: u32::MAX, ..d }),
+        ("range", kdw_engine_def { scale: 0.0, ..d }),
+        ("range", kdw_engine_def { scale: -1.0, ..d }),
+        ("range", kdw_engine_def { scale: 1e-7, ..d }),
+        ("huge", kdw_engine_def { scale: 1e7, ..d }),
+        ("range", kdw_engine_def { sleep_speed: -1.0, ..d }),
+        ("range", kdw_engine_def { lod: u32::MAX, ..d }),
     ];
     for (tag, def) in ranged {
         out.push((format!("{tag}:{{}}"), def, KDW_STATUS_INVALID_ARGUMENT));
@@ -495,13 +559,14 @@ fn chain_def_variants() -> Vec<(String, kdw_chain_def, kdw_status)> {
     for size in [0u32, d.struct_size - 4, d.struct_size + 4, u32::MAX] {
         out.push(("struct_size:{}".into(), kdw_chain_def { struct_size: size, ..d }, KDW_STATUS_STRUCT_SIZE_MISMATCH));
     }
-    let fields: [(&str, fn(&mut kdw_chain_def, f32)); 6] = [
+    let fields: [(&str, fn(&mut kdw_chain_def, f32)); 7] = [
         ("stiffness", |d, v| d.stiffness = v),
         ("damping", |d, v| d.damping = v),
         ("momentum_suppression", |d, v| d.momentum_suppression = v),
         ("mass", |d, v| d.mass = v),
         ("radius", |d, v| d.radius = v),
         ("gravity_scale", |d, v| d.gravity_scale = v),
+        ("friction", |d, v| d.friction = v),
     ];
     for (field, set) in fields {
         for (tag, v) in BAD_FLOATS {
@@ -510,7 +575,7 @@ fn chain_def_variants() -> Vec<(String, kdw_chain_def, kdw_status)> {
             out.push((format!("{tag}:{{}}.{field}"), def, KDW_STATUS_INVALID_ARGUMENT));
         }
     }
-    let ranged: [(&str, kdw_chain_def); 13] = [
+    let ranged: [(&str, kdw_chain_def); 17] = [
         ("huge", kdw_chain_def { stiffness: 1e30, ..d }),
         ("range", kdw_chain_def { stiffness: -0.1, ..d }),
         ("range", kdw_chain_def { stiffness: 1.01, ..d }),
@@ -524,6 +589,10 @@ fn chain_def_variants() -> Vec<(String, kdw_chain_def, kdw_status)> {
         ("huge", kdw_chain_def { gravity_scale: -1e30, ..d }),
         ("range", kdw_chain_def { anchor: 2, ..d }),
         ("range", kdw_chain_def { anchor: u32::MAX, ..d }),
+        ("range", kdw_chain_def { friction: -1.0, ..d }),
+        ("range", kdw_chain_def { friction: 11.0, ..d }),
+        ("huge", kdw_chain_def { friction: 1e30, ..d }),
+        ("huge", kdw_chain_def { radius: 1e7, ..d }),
     ];
     for (tag, def) in ranged {
         out.push((format!("{tag}:{{}}"), def, KDW_STATUS_INVALID_ARGUMENT));
@@ -827,8 +896,11 @@ fn cases(fx: &Fixture) -> Vec<Case> {
     }
 
     // -- engine queries
-    let queries_u32: [(&'static str, extern "C" fn(*const kdw_engine, *mut u32) -> kdw_status); 2] =
-        [("kdw_engine_chain_count", kdw_engine_chain_count), ("kdw_engine_joint_count", kdw_engine_joint_count)];
+    let queries_u32: [(&'static str, extern "C" fn(*const kdw_engine, *mut u32) -> kdw_status); 3] = [
+        ("kdw_engine_chain_count", kdw_engine_chain_count),
+        ("kdw_engine_joint_count", kdw_engine_joint_count),
+        ("kdw_engine_collider_count", kdw_engine_collider_count),
+    ];
     for (name, f) in queries_u32 {
         c.push(case(name, "null:engine", nullp, Box::new(move |_| out(SENTINEL_U32, |o| f(null(), o)))));
         c.push(case(name, "null:out_count", nullp, Box::new(move |fx| (f(fx.a, null_mut()), true))));
@@ -1062,10 +1134,12 @@ fn cases(fx: &Fixture) -> Vec<Case> {
             Box::new(move |fx| (kdw_chain_set_base_shape(fx.a, fx.chain, j.as_ptr(), N), true)),
         ));
     }
-    let chain_u32: [(&'static str, &'static str, extern "C" fn(*const kdw_engine, u64, *mut u32) -> kdw_status); 3] = [
+    let chain_u32: [(&'static str, &'static str, extern "C" fn(*const kdw_engine, u64, *mut u32) -> kdw_status); 5] = [
         ("kdw_chain_is_valid", "out_valid", kdw_chain_is_valid),
         ("kdw_chain_joint_count", "out_count", kdw_chain_joint_count),
         ("kdw_chain_view_shape_count", "out_count", kdw_chain_view_shape_count),
+        ("kdw_chain_is_enabled", "out_enabled", kdw_chain_is_enabled),
+        ("kdw_chain_is_asleep", "out_asleep", kdw_chain_is_asleep),
     ];
     for (name, out_name, f) in chain_u32 {
         c.push(case(name, "null:engine", nullp, Box::new(move |fx| out(SENTINEL_U32, |o| f(null(), fx.chain, o)))));
@@ -1162,6 +1236,24 @@ fn cases(fx: &Fixture) -> Vec<Case> {
             t.clone(),
             badid,
             Box::new(move |fx| out(SENTINEL_U32, |o| kdw_chain_view_shape_count(fx.a, id, o))),
+        ));
+        c.push(case(
+            "kdw_chain_is_enabled",
+            t.clone(),
+            badid,
+            Box::new(move |fx| out(SENTINEL_U32, |o| kdw_chain_is_enabled(fx.a, id, o))),
+        ));
+        c.push(case(
+            "kdw_chain_is_asleep",
+            t.clone(),
+            badid,
+            Box::new(move |fx| out(SENTINEL_U32, |o| kdw_chain_is_asleep(fx.a, id, o))),
+        ));
+        c.push(case(
+            "kdw_chain_set_enabled",
+            t.clone(),
+            badid,
+            Box::new(move |fx| (kdw_chain_set_enabled(fx.a, id, 0), true)),
         ));
         c.push(case(
             "kdw_chain_kinetic_energy",
@@ -1390,6 +1482,15 @@ fn cases(fx: &Fixture) -> Vec<Case> {
             Box::new(move |fx| (kdw_view_shape_set_joints(fx.a, id, joints(N, 1.0).as_ptr(), N), true)),
         ));
     }
+
+    collider_and_teleport_cases(fx, &mut c);
+    c.push(case(
+        "kdw_chain_set_enabled",
+        "null:engine",
+        nullp,
+        Box::new(|fx| (kdw_chain_set_enabled(null_mut(), fx.chain, 0), true)),
+    ));
+    engines_step_cases(&mut c);
 
     // -- one-call frame
     let anchors2 = [head(); 2];
@@ -1641,6 +1742,351 @@ fn cases(fx: &Fixture) -> Vec<Case> {
     c
 }
 
+/// Every way a collider def can be wrong, each with the status it must be rejected with.
+fn collider_def_variants() -> Vec<(String, kdw_collider_def, kdw_status)> {
+    let sphere = collider_def(KDW_COLLIDER_SPHERE, 0.1, 0.0);
+    let capsule = collider_def(KDW_COLLIDER_CAPSULE, 0.05, 0.1);
+    let mut out = Vec::new();
+    for size in [0u32, sphere.struct_size - 4, sphere.struct_size + 4, u32::MAX] {
+        out.push((
+            "struct_size:{}".into(),
+            kdw_collider_def { struct_size: size, ..sphere },
+            KDW_STATUS_STRUCT_SIZE_MISMATCH,
+        ));
+    }
+    // Floats only a capsule reads are broken on a capsule (a sphere ignores `half_height`: see the report).
+    let fields: [(&str, kdw_collider_def, fn(&mut kdw_collider_def, f32)); 11] = [
+        ("radius", sphere, |d, v| d.radius = v),
+        ("radius", capsule, |d, v| d.radius = v),
+        ("half_height", capsule, |d, v| d.half_height = v),
+        ("transform.position.x", sphere, |d, v| d.transform.position.x = v),
+        ("transform.position.y", sphere, |d, v| d.transform.position.y = v),
+        ("transform.position.z", sphere, |d, v| d.transform.position.z = v),
+        ("transform.rotation.x", sphere, |d, v| d.transform.rotation.x = v),
+        ("transform.rotation.y", sphere, |d, v| d.transform.rotation.y = v),
+        ("transform.rotation.z", sphere, |d, v| d.transform.rotation.z = v),
+        ("transform.rotation.w", sphere, |d, v| d.transform.rotation.w = v),
+        ("transform.rotation.w", capsule, |d, v| d.transform.rotation.w = v),
+    ];
+    for (field, base, set) in fields {
+        for (tag, v) in BAD_FLOATS {
+            let mut def = base;
+            set(&mut def, v);
+            out.push((format!("{tag}:{{}}.{field}"), def, KDW_STATUS_INVALID_ARGUMENT));
+        }
+    }
+    let null_rotation = kdw_quat { x: 0.0, y: 0.0, z: 0.0, w: 0.0 };
+    let far = kdw_transform { position: vec3(0.0, 1e30, 0.0), ..head() };
+    let ranged: [(&str, kdw_collider_def); 18] = [
+        ("range", kdw_collider_def { radius: -0.01, ..sphere }),
+        ("range", kdw_collider_def { radius: -0.01, ..capsule }),
+        ("range", kdw_collider_def { half_height: -0.01, ..capsule }),
+        ("huge", kdw_collider_def { radius: 1e7, ..sphere }),
+        ("huge", kdw_collider_def { half_height: 1e30, ..capsule }),
+        ("degenerate", collider_def(KDW_COLLIDER_CAPSULE, 0.0, 0.0)),
+        ("degenerate", collider_def(KDW_COLLIDER_INSIDE_CAPSULE, 0.0, 0.0)),
+        ("inside-zero", collider_def(KDW_COLLIDER_INSIDE_SPHERE, 0.0, 0.0)),
+        ("inside-zero", collider_def(KDW_COLLIDER_INSIDE_CAPSULE, 0.0, 0.1)),
+        ("range", collider_def(KDW_COLLIDER_INSIDE_SPHERE, -1.0, 0.0)),
+        ("shape", collider_def(KDW_COLLIDER_INSIDE_CAPSULE + 1, 0.1, 0.0)),
+        ("shape", collider_def(u32::MAX, 0.1, 0.0)),
+        (
+            "nullquat",
+            kdw_collider_def { transform: kdw_transform { rotation: null_rotation, ..sphere.transform }, ..sphere },
+        ),
+        ("nullquat", kdw_collider_def { transform: kdw_transform { rotation: null_rotation, ..head() }, ..capsule }),
+        ("huge", kdw_collider_def { transform: far, ..sphere }),
+        ("huge", kdw_collider_def { transform: far, ..collider_def(KDW_COLLIDER_PLANE, 0.0, 0.0) }),
+        (
+            "range",
+            kdw_collider_def { transform: kdw_transform { position: vec3(-1.1e9, 0.0, 0.0), ..head() }, ..sphere },
+        ),
+        (
+            "nan",
+            kdw_collider_def {
+                transform: kdw_transform { position: vec3(f32::NAN, 0.0, 0.0), ..head() },
+                ..collider_def(KDW_COLLIDER_PLANE, 0.0, 0.0)
+            },
+        ),
+    ];
+    for (tag, def) in ranged {
+        out.push((format!("{tag}:{{}}"), def, KDW_STATUS_INVALID_ARGUMENT));
+    }
+    out
+}
+
+/// Colliders, per-joint radii and teleports: every pointer NULL, every id bad, counts wrong, values out of range.
+fn collider_and_teleport_cases(fx: &Fixture, c: &mut Vec<Case>) {
+    let (nullp, badid, badarg, small) =
+        (KDW_STATUS_NULL_POINTER, KDW_STATUS_INVALID_ID, KDW_STATUS_INVALID_ARGUMENT, KDW_STATUS_BUFFER_TOO_SMALL);
+    let sphere = collider_def(KDW_COLLIDER_SPHERE, 0.1, 0.0);
+
+    // -- create
+    c.push(case(
+        "kdw_collider_create",
+        "null:engine",
+        nullp,
+        Box::new(move |_| out(SENTINEL_U64, |o| kdw_collider_create(null_mut(), &sphere, o))),
+    ));
+    c.push(case(
+        "kdw_collider_create",
+        "null:def",
+        nullp,
+        Box::new(|fx| out(SENTINEL_U64, |o| kdw_collider_create(fx.a, null(), o))),
+    ));
+    c.push(case(
+        "kdw_collider_create",
+        "null:out_collider",
+        nullp,
+        Box::new(move |fx| (kdw_collider_create(fx.a, &sphere, null_mut()), true)),
+    ));
+    for (tag, def, expected) in collider_def_variants() {
+        c.push(case(
+            "kdw_collider_create",
+            tag.replace("{}", "def"),
+            expected,
+            Box::new(move |fx| out(SENTINEL_U64, |o| kdw_collider_create(fx.a, &def, o))),
+        ));
+    }
+
+    // -- ids
+    c.push(case(
+        "kdw_collider_destroy",
+        "null:engine",
+        nullp,
+        Box::new(|fx| (kdw_collider_destroy(null_mut(), fx.collider), true)),
+    ));
+    c.push(case(
+        "kdw_collider_is_valid",
+        "null:engine",
+        nullp,
+        Box::new(|fx| out(SENTINEL_U32, |o| kdw_collider_is_valid(null(), fx.collider, o))),
+    ));
+    c.push(case(
+        "kdw_collider_is_valid",
+        "null:out_valid",
+        nullp,
+        Box::new(|fx| (kdw_collider_is_valid(fx.a, fx.collider, null_mut()), true)),
+    ));
+    c.push(case(
+        "kdw_collider_set_layers",
+        "null:engine",
+        nullp,
+        Box::new(|fx| (kdw_collider_set_layers(null_mut(), fx.collider, 2), true)),
+    ));
+    for (tag, id) in fx.bad_collider_ids() {
+        let t = format!("{tag}:collider");
+        c.push(case(
+            "kdw_collider_destroy",
+            t.clone(),
+            badid,
+            Box::new(move |fx| (kdw_collider_destroy(fx.a, id), true)),
+        ));
+        c.push(case(
+            "kdw_collider_set_layers",
+            t.clone(),
+            badid,
+            Box::new(move |fx| (kdw_collider_set_layers(fx.a, id, 2), true)),
+        ));
+    }
+
+    // -- batched collider poses (the fixture's engine `a` has 2 colliders)
+    c.push(case(
+        "kdw_engine_set_collider_transforms",
+        "null:engine",
+        nullp,
+        Box::new(|_| (kdw_engine_set_collider_transforms(null_mut(), collider_poses().as_ptr(), 2), true)),
+    ));
+    c.push(case(
+        "kdw_engine_set_collider_transforms",
+        "null:transforms",
+        nullp,
+        Box::new(|fx| (kdw_engine_set_collider_transforms(fx.a, null(), fx.collider_total), true)),
+    ));
+    for count in [0u32, 1, 3] {
+        c.push(case(
+            "kdw_engine_set_collider_transforms",
+            format!("count:count={count}"),
+            badarg,
+            Box::new(move |fx| {
+                let poses = [collider_poses()[0]; 3];
+                (kdw_engine_set_collider_transforms(fx.a, poses.as_ptr(), count), true)
+            }),
+        ));
+    }
+    c.push(case(
+        "kdw_engine_set_collider_transforms",
+        "count:count=0,NULL",
+        badarg,
+        Box::new(|fx| (kdw_engine_set_collider_transforms(fx.a, null(), 0), true)),
+    ));
+    let mut bad_poses = bad_transforms();
+    bad_poses.push(("huge".into(), kdw_transform { position: vec3(1e30, 0.0, 0.0), ..head() }));
+    bad_poses.push(("range".into(), kdw_transform { position: vec3(0.0, 0.0, -2e9), ..head() }));
+    for (tag, t) in bad_poses {
+        for slot in 0..2 {
+            c.push(case(
+                "kdw_engine_set_collider_transforms",
+                format!("{tag}:transforms"),
+                badarg,
+                Box::new(move |fx| {
+                    let mut poses = collider_poses();
+                    poses[slot] = t;
+                    (kdw_engine_set_collider_transforms(fx.a, poses.as_ptr(), fx.collider_total), true)
+                }),
+            ));
+        }
+    }
+
+    // -- collider ids read-back
+    c.push(case(
+        "kdw_engine_get_collider_ids",
+        "null:engine",
+        nullp,
+        Box::new(|_| buffer(SENTINEL_U64, 4, |b, w| kdw_engine_get_collider_ids(null(), b, 4, w))),
+    ));
+    c.push(case(
+        "kdw_engine_get_collider_ids",
+        "null:out_ids",
+        nullp,
+        Box::new(|fx| out(SENTINEL_U32, |w| kdw_engine_get_collider_ids(fx.a, null_mut(), fx.collider_total, w))),
+    ));
+    c.push(case(
+        "kdw_engine_get_collider_ids",
+        "null:out_written",
+        nullp,
+        Box::new(|fx| buffer(SENTINEL_U64, 4, |b, _| kdw_engine_get_collider_ids(fx.a, b, 4, null_mut()))),
+    ));
+    for cap in [0u32, 1] {
+        c.push(case(
+            "kdw_engine_get_collider_ids",
+            format!("count:capacity={cap}"),
+            small,
+            Box::new(move |fx| buffer(SENTINEL_U64, 4, |b, w| kdw_engine_get_collider_ids(fx.a, b, cap, w))),
+        ));
+    }
+
+    // -- per-joint radii (the fixture's chains have N joints)
+    let radii = [0.01f32; N as usize + 1];
+    c.push(case(
+        "kdw_chain_set_joint_radii",
+        "null:engine",
+        nullp,
+        Box::new(move |fx| (kdw_chain_set_joint_radii(null_mut(), fx.chain, radii.as_ptr(), N), true)),
+    ));
+    c.push(case(
+        "kdw_chain_set_joint_radii",
+        "null:radii",
+        nullp,
+        Box::new(|fx| (kdw_chain_set_joint_radii(fx.a, fx.chain, null(), N), true)),
+    ));
+    for count in [1u32, N - 1, N + 1] {
+        c.push(case(
+            "kdw_chain_set_joint_radii",
+            format!("count:count={count}"),
+            badarg,
+            Box::new(move |fx| (kdw_chain_set_joint_radii(fx.a, fx.chain, radii.as_ptr(), count), true)),
+        ));
+    }
+    let bad_radii = BAD_FLOATS.into_iter().chain([("range", -0.01f32), ("range", -0.0 - 1e-30), ("huge", 1e7)]);
+    for (tag, r) in bad_radii {
+        for joint in [0usize, N as usize - 1] {
+            c.push(case(
+                "kdw_chain_set_joint_radii",
+                format!("{tag}:radii"),
+                badarg,
+                Box::new(move |fx| {
+                    let mut radii = [0.01f32; N as usize];
+                    radii[joint] = r;
+                    (kdw_chain_set_joint_radii(fx.a, fx.chain, radii.as_ptr(), N), true)
+                }),
+            ));
+        }
+    }
+
+    // -- teleports
+    c.push(case("kdw_engine_teleport", "null:engine", nullp, Box::new(|_| (kdw_engine_teleport(null_mut()), true))));
+    c.push(case(
+        "kdw_chain_teleport",
+        "null:engine",
+        nullp,
+        Box::new(|fx| (kdw_chain_teleport(null_mut(), fx.chain), true)),
+    ));
+    for (tag, id) in fx.bad_chain_ids() {
+        let t = format!("{tag}:chain");
+        c.push(case("kdw_chain_teleport", t.clone(), badid, Box::new(move |fx| (kdw_chain_teleport(fx.a, id), true))));
+        c.push(case(
+            "kdw_chain_set_joint_radii",
+            t.clone(),
+            badid,
+            Box::new(move |fx| (kdw_chain_set_joint_radii(fx.a, id, radii.as_ptr(), N), true)),
+        ));
+    }
+}
+
+/// `kdw_engines_step` over the fixture's two engines: one bad handle, input or count fails the whole call.
+fn engines_step_cases(c: &mut Vec<Case>) {
+    let (nullp, badarg) = (KDW_STATUS_NULL_POINTER, KDW_STATUS_INVALID_ARGUMENT);
+    let references = [head(); 2];
+    let both = |fx: &Fixture| [fx.a, fx.b];
+    c.push(case(
+        "kdw_engines_step",
+        "null:engines",
+        nullp,
+        Box::new(move |_| (kdw_engines_step(null(), 2, 0.1, &camera(), references.as_ptr()), true)),
+    ));
+    c.push(case(
+        "kdw_engines_step",
+        "null:engines[1]",
+        nullp,
+        Box::new(move |fx| {
+            (kdw_engines_step([fx.a, null_mut()].as_ptr(), 2, 0.1, &camera(), references.as_ptr()), true)
+        }),
+    ));
+    c.push(case(
+        "kdw_engines_step",
+        "null:camera_position",
+        nullp,
+        Box::new(move |fx| (kdw_engines_step(both(fx).as_ptr(), 2, 0.1, null(), references.as_ptr()), true)),
+    ));
+    c.push(case(
+        "kdw_engines_step",
+        "null:view_references",
+        nullp,
+        Box::new(move |fx| (kdw_engines_step(both(fx).as_ptr(), 2, 0.1, &camera(), null()), true)),
+    ));
+    c.push(case(
+        "kdw_engines_step",
+        "count:count=repeated",
+        badarg,
+        Box::new(move |fx| (kdw_engines_step([fx.a, fx.a].as_ptr(), 2, 0.1, &camera(), references.as_ptr()), true)),
+    ));
+    for (tag, dt) in BAD_FLOATS.into_iter().chain([("range", -1e-6f32)]) {
+        c.push(case(
+            "kdw_engines_step",
+            format!("{tag}:dt"),
+            badarg,
+            Box::new(move |fx| (kdw_engines_step(both(fx).as_ptr(), 2, dt, &camera(), references.as_ptr()), true)),
+        ));
+    }
+    for (tag, p) in bad_vec3s() {
+        c.push(case(
+            "kdw_engines_step",
+            format!("{tag}:camera_position"),
+            badarg,
+            Box::new(move |fx| (kdw_engines_step(both(fx).as_ptr(), 2, 0.1, &p, references.as_ptr()), true)),
+        ));
+    }
+    for (tag, t) in bad_transforms() {
+        c.push(case(
+            "kdw_engines_step",
+            format!("{tag}:view_references"),
+            badarg,
+            Box::new(move |fx| (kdw_engines_step(both(fx).as_ptr(), 2, 0.1, &camera(), [head(), t].as_ptr()), true)),
+        ));
+    }
+}
+
 /// Covered outside the table (they do not fail in the usual way): `kdw_chain_is_valid` answers 0 for bad
 /// ids; `kdw_last_error_message` reports errors itself; the constant queries have nothing to reject.
 fn special_tags() -> BTreeMap<&'static str, Vec<String>> {
@@ -1652,6 +2098,10 @@ fn special_tags() -> BTreeMap<&'static str, Vec<String>> {
     // Documented: NULL is a no-op returning OK, like free(NULL) (`destroy_null_is_a_no_op`).
     m.insert("kdw_engine_destroy", vec!["null:engine".into()]);
     m.insert("kdw_chain_is_valid", ["zero", "stale", "foreign", "kind"].iter().map(|t| format!("{t}:chain")).collect());
+    m.insert(
+        "kdw_collider_is_valid",
+        ["zero", "stale", "foreign", "kind"].iter().map(|t| format!("{t}:collider")).collect(),
+    );
     m.insert("kdw_last_error_message", vec!["null:buffer".into(), "null:out_length".into(), "count:capacity".into()]);
     for f in [
         "kdw_chain_def_default",
@@ -1660,6 +2110,7 @@ fn special_tags() -> BTreeMap<&'static str, Vec<String>> {
         "kdw_version_string",
         "kdw_status_str",
         "kdw_stroke_camera_default",
+        "kdw_collider_def_default",
     ] {
         m.insert(f, vec!["call".into()]);
     }
@@ -1746,7 +2197,8 @@ fn destroy_null_is_a_no_op() {
     assert_eq!(kdw_engine_destroy(null_mut()), KDW_STATUS_OK);
 }
 
-/// `kdw_chain_is_valid` / `kdw_view_shape_is_valid` answer 0 (status OK) for every bad id, 1 for a good one.
+/// `kdw_chain_is_valid` / `kdw_view_shape_is_valid` / `kdw_collider_is_valid` answer 0 (status OK) for every bad
+/// id, 1 for a good one.
 #[test]
 fn is_valid_answers_zero_for_bad_ids() {
     let fx = Fixture::new();
@@ -1761,7 +2213,16 @@ fn is_valid_answers_zero_for_bad_ids() {
         assert_eq!(kdw_view_shape_is_valid(fx.a, id, &mut valid), KDW_STATUS_OK, "{tag}");
         assert_eq!(valid, 0, "{tag} view shape id reported valid");
     }
+    for (tag, id) in fx.bad_collider_ids() {
+        let mut valid = SENTINEL_U32;
+        assert_eq!(kdw_collider_is_valid(fx.a, id, &mut valid), KDW_STATUS_OK, "{tag}");
+        assert_eq!(valid, 0, "{tag} collider id reported valid");
+    }
     let mut valid = 0;
+    assert_eq!(kdw_collider_is_valid(fx.a, fx.collider, &mut valid), KDW_STATUS_OK);
+    assert_eq!(valid, 1);
+    assert_eq!(kdw_collider_is_valid(fx.b, fx.foreign_collider, &mut valid), KDW_STATUS_OK);
+    assert_eq!(valid, 1);
     assert_eq!(kdw_chain_is_valid(fx.a, fx.chain, &mut valid), KDW_STATUS_OK);
     assert_eq!(valid, 1);
     assert_eq!(kdw_view_shape_is_valid(fx.a, fx.view, &mut valid), KDW_STATUS_OK);
@@ -1818,6 +2279,7 @@ fn constant_queries() {
     assert_eq!(version, env!("CARGO_PKG_VERSION"));
     assert_eq!(kdw_engine_def_default().struct_size as usize, size_of::<kdw_engine_def>());
     assert_eq!(kdw_chain_def_default().struct_size as usize, size_of::<kdw_chain_def>());
+    assert_eq!(kdw_collider_def_default().struct_size as usize, size_of::<kdw_collider_def>());
 }
 
 type Setup = Box<dyn Fn(*mut kdw_engine, u64) -> kdw_status>;

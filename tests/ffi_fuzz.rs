@@ -1,7 +1,8 @@
 //! API fuzzing through the C ABI (SPEC 6.2): random sequences of C calls — create/destroy engines, chains
-//! (0..40 joints, random and invalid floats), view shapes, anchors with random counts, steps with random
-//! (also invalid) dt, reads with random capacities, resets, def changes — driven by proptest with a fixed
-//! ChaCha seed, so CI runs are reproducible.
+//! (0..40 joints, random and invalid floats), view shapes, colliders (random shapes, sizes, poses, layers;
+//! batched pose updates with random counts), per-joint radii, teleports, anchors with random counts, steps
+//! with random (also invalid) dt, reads with random capacities, resets, def changes — driven by proptest with
+//! a fixed ChaCha seed, so CI runs are reproducible.
 //!
 //! Invariants: no call returns `KDW_STATUS_PANIC`; every successful read returns finite values; issued ids
 //! are never 0; a destroyed object's id is rejected afterwards; a rejected call leaves the engine's state
@@ -17,6 +18,7 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
 
 use kodawari::ffi::chain::*;
+use kodawari::ffi::collider::*;
 use kodawari::ffi::engine::*;
 use kodawari::ffi::status::*;
 use kodawari::ffi::types::*;
@@ -58,7 +60,7 @@ fn any_float() -> impl Strategy<Value = f32> {
 }
 
 fn call() -> impl Strategy<Value = Call> {
-    (0u8..24, any::<u64>(), any::<u64>(), 0u32..40, [any_float(), any_float(), any_float(), any_float()])
+    (0u8..30, any::<u64>(), any::<u64>(), 0u32..40, [any_float(), any_float(), any_float(), any_float()])
         .prop_map(|(kind, pick, pick2, n, f)| Call { kind, pick, pick2, n, f })
 }
 
@@ -68,6 +70,7 @@ struct World {
     engines: Vec<*mut kdw_engine>,
     chains: Vec<(usize, u64, bool)>,
     views: Vec<(usize, u64, bool)>,
+    colliders: Vec<(usize, u64, bool)>,
     calls: u64,
     ok_calls: u64,
     /// Let huge finite positions through (the known-bug replay).
@@ -174,6 +177,30 @@ impl World {
         }
     }
 
+    /// A collider id for engine `e`: mostly one of its live colliders, else anything known (stale, foreign, a
+    /// chain id), 0, or random bits.
+    fn collider_id(&self, e: usize, pick: u64) -> u64 {
+        let own: Vec<u64> = self.colliders.iter().filter(|c| c.0 == e && c.2).map(|c| c.1).collect();
+        match pick % 10 {
+            0 => 0,
+            1 => pick,
+            2 if !self.chains.is_empty() => self.chains[(pick / 10) as usize % self.chains.len()].1,
+            3 | 4 if !self.colliders.is_empty() => self.colliders[(pick / 10) as usize % self.colliders.len()].1,
+            _ if !own.is_empty() => own[(pick / 10) as usize % own.len()],
+            _ => 0,
+        }
+    }
+
+    fn is_live_collider(&self, e: usize, id: u64) -> bool {
+        self.colliders.iter().any(|c| c.0 == e && c.1 == id && c.2)
+    }
+
+    fn collider_count(engine: *mut kdw_engine) -> u32 {
+        let mut n = 0;
+        assert_eq!(kdw_engine_collider_count(engine, &mut n), KDW_STATUS_OK);
+        n
+    }
+
     fn is_live_chain(&self, e: usize, id: u64) -> bool {
         self.chains.iter().any(|c| c.0 == e && c.1 == id && c.2)
     }
@@ -212,7 +239,8 @@ impl World {
                     self.engines.remove(e);
                     self.chains.retain(|x| x.0 != e);
                     self.views.retain(|x| x.0 != e);
-                    for x in self.chains.iter_mut().chain(self.views.iter_mut()) {
+                    self.colliders.retain(|x| x.0 != e);
+                    for x in self.chains.iter_mut().chain(self.views.iter_mut()).chain(self.colliders.iter_mut()) {
                         if x.0 > e {
                             x.0 -= 1;
                         }
@@ -394,7 +422,7 @@ impl World {
             }
             19 => {
                 let mut def = kdw_engine_def_default();
-                match c.pick2 % 8 {
+                match c.pick2 % 10 {
                     0 => def.gravity = vec3(tame(c.f[0]), tame(c.f[1]), tame(c.f[2])),
                     1 => def.substep_rate = c.f[0] * 1000.0,
                     2 => def.max_substeps = c.n * 30,
@@ -402,17 +430,22 @@ impl World {
                     4 => def.time_scale = c.f[0] * 10.0,
                     5 => def.teleport_distance = c.f[0],
                     6 => def.teleport_angle = c.f[0],
+                    7 => def.teleport_mode = (c.pick2 / 10 % 3) as u32,
+                    // Scale multiplies gravity and radii: tamed like gravity (huge valid gravity is a known bug).
+                    8 => def.scale = if c.f[1].is_finite() { c.f[1].abs().clamp(0.0, 1e3) } else { c.f[1] },
                     _ => def.struct_size = c.n,
                 }
                 kdw_engine_set_def(engine, &def)
             }
             20 => {
                 let mut def = kdw_chain_def_default();
-                match c.pick2 % 5 {
+                match c.pick2 % 7 {
                     0 => def.stiffness = c.f[0],
                     1 => def.damping = c.f[0] * 500.0,
                     2 => def.momentum_suppression = c.f[0],
                     3 => def.gravity_scale = c.f[0] * 50.0,
+                    4 => def.friction = c.f[0] * 6.0,
+                    5 => def.collision_mask = (c.pick2 >> 8) as u32,
                     _ => def.struct_size = c.n,
                 }
                 kdw_chain_set_def(engine, self.chain_id(e, c.pick2), &def)
@@ -426,9 +459,101 @@ impl World {
                 let j = joints(n, c.pick2 / 13 + 2, c.f[0]);
                 kdw_chain_set_base_shape(engine, chain, j.as_ptr(), n)
             }
-            _ => {
+            23 => {
                 let mut stats = kdw_engine_stats::default();
-                kdw_engine_get_stats(engine, &mut stats)
+                let s = kdw_engine_get_stats(engine, &mut stats);
+                prop_assert_eq!(stats.collider_count, Self::collider_count(engine), "stats.collider_count");
+                s
+            }
+            24 | 25 => {
+                // Create a collider: any shape (also unknown ones), random sizes, a valid or broken pose.
+                let mut def = kdw_collider_def_default();
+                def.shape = (c.pick2 % 6) as u32;
+                def.radius = if c.pick2 % 3 == 0 { c.f[0] } else { c.f[0].abs() % 0.5 };
+                def.half_height = if c.pick2 % 5 == 0 { c.f[1] } else { c.f[1].abs() % 0.5 };
+                def.transform = transform(c.f, c.pick2 % 4 != 0, self.untamed);
+                def.layers = (c.pick2 >> 16) as u32;
+                if c.pick2 % 11 == 0 {
+                    def.struct_size = c.n;
+                }
+                const UNWRITTEN: u64 = 0xDEAD_BEEF_CAFE_F00D;
+                let mut id = UNWRITTEN;
+                let s = kdw_collider_create(engine, &def, &mut id);
+                if s == KDW_STATUS_OK {
+                    prop_assert_ne!(id, 0, "issued collider id 0");
+                    prop_assert!(!self.colliders.iter().any(|x| x.1 == id), "collider id {:#x} issued twice", id);
+                    self.colliders.push((e, id, true));
+                } else {
+                    prop_assert_eq!(id, UNWRITTEN, "failed collider create wrote its output");
+                }
+                s
+            }
+            26 => {
+                let id = self.collider_id(e, c.pick2);
+                let s = kdw_collider_destroy(engine, id);
+                if s == KDW_STATUS_OK {
+                    prop_assert!(self.is_live_collider(e, id), "destroyed a collider id that was not live: {:#x}", id);
+                    for x in self.colliders.iter_mut().filter(|x| x.1 == id) {
+                        x.2 = false;
+                    }
+                    let mut valid = 9;
+                    prop_assert_eq!(kdw_collider_is_valid(engine, id, &mut valid), KDW_STATUS_OK);
+                    prop_assert_eq!(valid, 0, "destroyed collider still valid");
+                    prop_assert_eq!(kdw_collider_set_layers(engine, id, 1), KDW_STATUS_INVALID_ID);
+                } else {
+                    prop_assert!(!self.is_live_collider(e, id), "live collider {:#x} not destroyed: {}", id, s);
+                }
+                s
+            }
+            27 => {
+                // Batched collider poses: the right count most of the time, one broken pose now and then.
+                let colliders = Self::collider_count(engine);
+                let count = if c.pick2 % 4 == 0 { c.n } else { colliders };
+                let poses: Vec<kdw_transform> =
+                    (0..count).map(|i| transform(c.f, c.pick2 % 3 != 0 || i + 1 < count, self.untamed)).collect();
+                let s = kdw_engine_set_collider_transforms(engine, poses.as_ptr(), count);
+                if count != colliders {
+                    prop_assert_eq!(s, KDW_STATUS_INVALID_ARGUMENT, "collider pose count {} of {}", count, colliders);
+                }
+                s
+            }
+            28 => {
+                let chain = self.chain_id(e, c.pick2);
+                match c.pick2 % 4 {
+                    0 => kdw_collider_set_layers(engine, self.collider_id(e, c.pick2 / 4), (c.pick2 >> 32) as u32),
+                    1 => kdw_chain_teleport(engine, chain),
+                    2 => kdw_engine_teleport(engine),
+                    _ => {
+                        // Per-joint radii: one per joint mostly (or none), random (also invalid) values.
+                        let mut n = 0;
+                        kdw_chain_joint_count(engine, chain, &mut n);
+                        let n = match c.pick % 5 {
+                            0 => c.n,
+                            1 => 0,
+                            _ => n,
+                        };
+                        let radii: Vec<f32> = (0..n)
+                            .map(|j| if j as u64 == c.pick2 % 7 { c.f[j as usize % 4] } else { c.f[2].abs() % 0.05 })
+                            .collect();
+                        kdw_chain_set_joint_radii(engine, chain, radii.as_ptr(), n)
+                    }
+                }
+            }
+            _ => {
+                // Collider ids read back: creation order, exactly the live ones the fuzzer knows.
+                let colliders = Self::collider_count(engine);
+                let capacity = if c.pick2 % 3 == 0 { c.n } else { colliders };
+                let mut ids = vec![0u64; capacity as usize];
+                let mut written = 0;
+                let s = kdw_engine_get_collider_ids(engine, ids.as_mut_ptr(), capacity, &mut written);
+                if s == KDW_STATUS_OK {
+                    prop_assert_eq!(written, colliders);
+                    let live: Vec<u64> = self.colliders.iter().filter(|x| x.0 == e && x.2).map(|x| x.1).collect();
+                    prop_assert_eq!(&ids[..written as usize], &live[..], "collider ids out of creation order");
+                } else {
+                    prop_assert!(capacity < colliders && s == KDW_STATUS_BUFFER_TOO_SMALL, "collider ids: {}", s);
+                }
+                s
             }
         };
         prop_assert_ne!(status, KDW_STATUS_PANIC, "call kind {} panicked", c.kind);

@@ -3,15 +3,16 @@
 //   kodawari::Engine                      owns a kdw_engine* (move-only, destroyed by its destructor)
 //   kodawari::ViewDependentPhysicalObject a chain: non-owning handle (engine pointer + kdw_chain_id)
 //   kodawari::ViewShape                   a view shape of a chain: non-owning handle
-//   kodawari::EngineDef / ChainDef        the C def structs, initialised to the library defaults
+//   kodawari::Collider                    a collision shape of the engine: non-owning handle
+//   kodawari::EngineDef / ChainDef / ColliderDef  the C def structs, initialised to the library defaults
 //   kodawari::StrokeCamera, shapeFromStroke()  the sketch tool: a screen-space stroke -> a chain shape
 //
 // Errors: by default every failing call throws kodawari::Error (status + the library's message). Define
 // KODAWARI_NO_EXCEPTIONS before including this header to get no throws at all: the same methods then
 // return kodawari::Result<T> (or kodawari::Status for calls without a value), expected-style and
 // [[nodiscard]]. `kodawari::Ret<T>` names what a method returns in the current mode (T or Result<T>).
-// With exceptions, getters are [[nodiscard]]; a created chain or view shape handle may be ignored (the
-// engine owns the object).
+// With exceptions, getters are [[nodiscard]]; a created chain, view shape or collider handle may be ignored
+// (the engine owns the object).
 // Both modes can be mixed in one program: each lives in its own inline namespace.
 //
 // Handles hold the raw kdw_engine*, so they stay usable when the owning Engine object is moved, and must
@@ -51,6 +52,7 @@ using Quat = kdw_quat;
 using Transform = kdw_transform;
 using ChainId = kdw_chain_id;
 using ViewShapeId = kdw_view_shape_id;
+using ColliderId = kdw_collider_id;
 using EngineStats = kdw_engine_stats;
 using Vec2 = kdw_vec2;
 
@@ -261,6 +263,29 @@ struct ChainDef : kdw_chain_def {
     ChainDef() noexcept : kdw_chain_def(kdw_chain_def_default()) {}
 };
 
+/// A collider, initialised to kdw_collider_def_default() (a 0.1 m sphere at the origin on layer 1). Shapes:
+/// KDW_COLLIDER_SPHERE, _CAPSULE (along local Y), _PLANE (solid below local Y), _INSIDE_SPHERE, _INSIDE_CAPSULE.
+/// Sizes and the pose are world units.
+struct ColliderDef : kdw_collider_def {
+    /// The library defaults.
+    ColliderDef() noexcept : kdw_collider_def(kdw_collider_def_default()) {}
+    /// A sphere of `radius` at `pose`.
+    static ColliderDef sphere(float radius, const Transform& pose) noexcept {
+        ColliderDef def;
+        def.shape = KDW_COLLIDER_SPHERE;
+        def.radius = radius;
+        def.transform = pose;
+        return def;
+    }
+    /// A capsule: `radius` around the segment from -halfHeight to +halfHeight on the pose's local Y axis.
+    static ColliderDef capsule(float radius, float halfHeight, const Transform& pose) noexcept {
+        ColliderDef def = sphere(radius, pose);
+        def.shape = KDW_COLLIDER_CAPSULE;
+        def.half_height = halfHeight;
+        return def;
+    }
+};
+
 /// The camera a stroke was drawn in, initialised to kdw_stroke_camera_default() (perspective, 60° vertical
 /// field of view, 1920 x 1080 pixels, looking along its local -Z; set forwardAxis to
 /// KDW_CAMERA_FORWARD_POSITIVE_Z for Unity's position and rotation). Pixels: origin top-left, y down.
@@ -350,6 +375,43 @@ private:
     ViewShapeId id_ = 0;
 };
 
+/// A collider of an engine: non-owning handle (engine pointer + id), cheap to copy. Its pose is set for all
+/// colliders at once by Engine::setColliderTransforms (creation order, see Engine::colliderIds).
+class Collider {
+public:
+    /// The null handle.
+    Collider() noexcept = default;
+    /// Wraps an id of `engine`.
+    Collider(kdw_engine* engine, ColliderId id) noexcept : engine_(engine), id_(id) {}
+
+    /// The engine this collider belongs to.
+    kdw_engine* engine() const noexcept { return engine_; }
+    /// The C id.
+    ColliderId id() const noexcept { return id_; }
+
+    /// True if the id names a live collider of its engine (false for null, destroyed or foreign ids).
+    [[nodiscard]] bool isValid() const noexcept {
+        uint32_t valid = 0;
+        return engine_ != nullptr && id_ != 0 && kdw_collider_is_valid(engine_, id_, &valid) == KDW_STATUS_OK &&
+               valid != 0;
+    }
+    /// Moves the collider to other layers: it affects chains whose collision mask shares a bit.
+    Ret<void> setLayers(uint32_t layers) const { return detail::check(kdw_collider_set_layers(engine_, id_, layers)); }
+    /// Destroys the collider; this handle (and its copies) become invalid. Later colliders keep their order.
+    Ret<void> destroy() const { return detail::check(kdw_collider_destroy(engine_, id_)); }
+
+    /// Same engine and id.
+    friend bool operator==(const Collider& a, const Collider& b) noexcept {
+        return a.engine_ == b.engine_ && a.id_ == b.id_;
+    }
+    /// Different engine or id.
+    friend bool operator!=(const Collider& a, const Collider& b) noexcept { return !(a == b); }
+
+private:
+    kdw_engine* engine_ = nullptr;
+    ColliderId id_ = 0;
+};
+
 /// A chain (hair strand, ear, tail): non-owning handle (engine pointer + id), cheap to copy. Methods are
 /// const because the handle is a value like an id; they act on the chain inside the engine.
 class ViewDependentPhysicalObject {
@@ -389,6 +451,14 @@ public:
     Ret<void> setBaseShape(Span<const Transform> joints) const { return setBaseShape(joints.data(), joints.size()); }
     /// Puts the chain back to its rest shape, at rest, at the next step.
     Ret<void> reset() const { return detail::check(kdw_chain_reset(engine_, id_)); }
+    /// Treats the anchor's motion in the next step as a teleport (the engine's teleport_mode), however small.
+    Ret<void> teleport() const { return detail::check(kdw_chain_teleport(engine_, id_)); }
+    /// Per-joint collision radii (character units, x the engine's scale): one per joint, each in [0, 1e6].
+    Ret<void> setJointRadii(const float* radii, uint32_t count) const {
+        return detail::check(kdw_chain_set_joint_radii(engine_, id_, radii, count));
+    }
+    /// Per-joint collision radii (one per joint); an empty span goes back to the def's radius for every joint.
+    Ret<void> setJointRadii(Span<const float> radii) const { return setJointRadii(radii.data(), radii.size()); }
 
     /// Number of joints.
     [[nodiscard]] Ret<uint32_t> jointCount() const {
@@ -475,7 +545,7 @@ private:
     ChainId id_ = 0;
 };
 
-/// One per character: owns its chains and view shapes. Move-only; the destructor destroys the engine.
+/// One per character: owns its chains, view shapes and colliders. Move-only; the destructor destroys the engine.
 class Engine {
 public:
     /// An empty engine (falsy); assign one from create().
@@ -615,6 +685,9 @@ public:
     }
     /// Puts every chain back to its rest shape, at rest, at the next step.
     Ret<void> reset() { return detail::check(kdw_engine_reset(handle_)); }
+    /// Every chain treats its anchor's motion in the next step as a teleport (teleport_mode), however small:
+    /// call it when the character is placed somewhere new.
+    Ret<void> teleport() { return detail::check(kdw_engine_teleport(handle_)); }
     /// A hash of everything that determines future results (determinism and "unchanged" checks).
     [[nodiscard]] Ret<uint64_t> stateHash() const {
         uint64_t hash = 0;
@@ -631,6 +704,44 @@ public:
     /// Creates a chain from its base shape (>= 2 joints, anchor frame, root first).
     Ret<ViewDependentPhysicalObject> createChain(const ChainDef& def, Span<const Transform> joints) {
         return createChain(def, joints.data(), joints.size());
+    }
+
+    /// Creates a collider; chains whose collision mask shares a bit with its layers are kept out of it (or in).
+    Ret<Collider> createCollider(const ColliderDef& def) {
+        ColliderId id = 0;
+        const kdw_status status = kdw_collider_create(handle_, &def, &id);
+        return detail::result(status, Collider(handle_, id));
+    }
+    /// Destroys a collider (as Collider::destroy).
+    Ret<void> destroyCollider(const Collider& collider) {
+        return detail::check(kdw_collider_destroy(handle_, collider.id()));
+    }
+    /// A handle for a collider id of this engine (not checked here; see isValid()).
+    Collider collider(ColliderId id) noexcept { return {handle_, id}; }
+    /// Number of colliders.
+    [[nodiscard]] Ret<uint32_t> colliderCount() const {
+        uint32_t count = 0;
+        const kdw_status status = kdw_engine_collider_count(handle_, &count);
+        return detail::result(status, count);
+    }
+    /// Collider ids in creation order (the order of setColliderTransforms) into `out`; returns how many.
+    [[nodiscard]] Ret<uint32_t> colliderIds(ColliderId* out, uint32_t capacity) const {
+        uint32_t written = 0;
+        const kdw_status status = kdw_engine_get_collider_ids(handle_, out, capacity, &written);
+        return detail::result(status, written);
+    }
+    /// Collider ids in creation order; `out` is resized to the collider count (no allocation if it fits).
+    Ret<void> colliderIds(std::vector<ColliderId>& out) const {
+        return readInto(out, kdw_engine_collider_count, kdw_engine_get_collider_ids);
+    }
+    /// Every collider's world pose for the next step, in ONE call: `count` == colliderCount(), creation order.
+    /// The step sweeps each collider from its last pose to this one.
+    Ret<void> setColliderTransforms(const Transform* poses, uint32_t count) {
+        return detail::check(kdw_engine_set_collider_transforms(handle_, poses, count));
+    }
+    /// Every collider's world pose for the next step (one per collider, creation order).
+    Ret<void> setColliderTransforms(Span<const Transform> poses) {
+        return setColliderTransforms(poses.data(), poses.size());
     }
 
 private:

@@ -7,6 +7,7 @@
  * does not leak. Everything is deterministic: no clocks, no random numbers.
  */
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -23,12 +24,14 @@
 _Static_assert(sizeof(kdw_vec3) == 12, "kdw_vec3 is 12 bytes");
 _Static_assert(sizeof(kdw_quat) == 16, "kdw_quat is 16 bytes");
 _Static_assert(sizeof(kdw_transform) == 28, "kdw_transform is 28 bytes");
-_Static_assert(sizeof(kdw_engine_def) == 40, "kdw_engine_def is 40 bytes");
-_Static_assert(sizeof(kdw_chain_def) == 32, "kdw_chain_def is 32 bytes");
-_Static_assert(sizeof(kdw_engine_stats) == 56, "kdw_engine_stats is 56 bytes");
+_Static_assert(sizeof(kdw_engine_def) == 56, "kdw_engine_def is 56 bytes");
+_Static_assert(sizeof(kdw_chain_def) == 40, "kdw_chain_def is 40 bytes");
+_Static_assert(sizeof(kdw_engine_stats) == 64, "kdw_engine_stats is 64 bytes");
+_Static_assert(sizeof(kdw_collider_def) == 48, "kdw_collider_def is 48 bytes");
 _Static_assert(sizeof(kdw_status) == 4, "kdw_status is int32_t");
 _Static_assert(sizeof(kdw_chain_id) == 8, "kdw_chain_id is uint64_t");
 _Static_assert(sizeof(kdw_view_shape_id) == 8, "kdw_view_shape_id is uint64_t");
+_Static_assert(sizeof(kdw_collider_id) == 8, "kdw_collider_id is uint64_t");
 
 _Static_assert(offsetof(kdw_vec3, x) == 0 && offsetof(kdw_vec3, y) == 4 && offsetof(kdw_vec3, z) == 8,
                "kdw_vec3 fields are packed");
@@ -46,6 +49,10 @@ _Static_assert(offsetof(kdw_engine_def, iterations) == 24, "kdw_engine_def layou
 _Static_assert(offsetof(kdw_engine_def, time_scale) == 28, "kdw_engine_def layout");
 _Static_assert(offsetof(kdw_engine_def, teleport_distance) == 32, "kdw_engine_def layout");
 _Static_assert(offsetof(kdw_engine_def, teleport_angle) == 36, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, teleport_mode) == 40, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, sleep_speed) == 44, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, lod) == 48, "kdw_engine_def layout");
+_Static_assert(offsetof(kdw_engine_def, scale) == 52, "kdw_engine_def layout");
 
 _Static_assert(offsetof(kdw_chain_def, struct_size) == 0, "kdw_chain_def layout");
 _Static_assert(offsetof(kdw_chain_def, stiffness) == 4, "kdw_chain_def layout");
@@ -55,17 +62,34 @@ _Static_assert(offsetof(kdw_chain_def, mass) == 16, "kdw_chain_def layout");
 _Static_assert(offsetof(kdw_chain_def, radius) == 20, "kdw_chain_def layout");
 _Static_assert(offsetof(kdw_chain_def, gravity_scale) == 24, "kdw_chain_def layout");
 _Static_assert(offsetof(kdw_chain_def, anchor) == 28, "kdw_chain_def layout");
+_Static_assert(offsetof(kdw_chain_def, collision_mask) == 32, "kdw_chain_def layout");
+_Static_assert(offsetof(kdw_chain_def, friction) == 36, "kdw_chain_def layout");
+
+_Static_assert(offsetof(kdw_collider_def, struct_size) == 0, "kdw_collider_def layout");
+_Static_assert(offsetof(kdw_collider_def, shape) == 4, "kdw_collider_def layout");
+_Static_assert(offsetof(kdw_collider_def, radius) == 8, "kdw_collider_def layout");
+_Static_assert(offsetof(kdw_collider_def, half_height) == 12, "kdw_collider_def layout");
+_Static_assert(offsetof(kdw_collider_def, transform) == 16, "kdw_collider_def layout");
+_Static_assert(offsetof(kdw_collider_def, layers) == 44, "kdw_collider_def layout");
 
 _Static_assert(offsetof(kdw_engine_stats, struct_size) == 0, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, chain_count) == 4, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, joint_count) == 8, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, substeps_last_step) == 12, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, chains_asleep) == 16, "kdw_engine_stats layout");
-_Static_assert(offsetof(kdw_engine_stats, reserved) == 20, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, collider_count) == 20, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, substeps_total) == 24, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, solver_fallbacks) == 32, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, time_dropped) == 40, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, simulated_time) == 48, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, contact_pairs_tested) == 56, "kdw_engine_stats layout");
+
+/* The constants the bindings mirror. */
+_Static_assert(KDW_ABI_VERSION == 2, "colliders, teleport modes and scale are ABI version 2");
+_Static_assert(KDW_COLLIDER_SPHERE == 0 && KDW_COLLIDER_CAPSULE == 1 && KDW_COLLIDER_PLANE == 2 &&
+                   KDW_COLLIDER_INSIDE_SPHERE == 3 && KDW_COLLIDER_INSIDE_CAPSULE == 4,
+               "collider shapes");
+_Static_assert(KDW_TELEPORT_CARRY_SHAPE == 0 && KDW_TELEPORT_RESET == 1, "teleport modes");
 
 /* ---- constants ------------------------------------------------------------------------------------------ */
 
@@ -509,7 +533,7 @@ static int test_layout(void)
     memset(&stats, SENTINEL_BYTE, sizeof stats);
     ENSURE_OK(kdw_engine_get_stats(engine, &stats));
     ENSURE(stats.struct_size == sizeof(kdw_engine_stats));
-    ENSURE(stats.reserved == 0);
+    ENSURE(stats.collider_count == 0 && stats.contact_pairs_tested == 0);
     ENSURE(stats.chain_count == 0 && stats.joint_count == 0 && stats.substeps_total == 0);
     ENSURE(stats.simulated_time == 0.0 && stats.time_dropped == 0.0);
     ENSURE_OK(engine_free(engine));
@@ -558,11 +582,19 @@ static int test_defaults_and_settings(void)
     ENSURE(def.substep_rate == 240.0f && def.max_substeps == 16 && def.iterations == 2);
     ENSURE(def.time_scale == 1.0f && def.teleport_distance == 1.0f);
     ENSURE_SMALL(def.teleport_angle - 0.5f * PI_F, 1e-6);
+    ENSURE(def.teleport_mode == KDW_TELEPORT_CARRY_SHAPE && def.scale == 1.0f);
 
     kdw_chain_def chain = kdw_chain_def_default();
     ENSURE(chain.stiffness == 0.5f && chain.damping == 1.0f && chain.momentum_suppression == 1.0f);
     ENSURE(chain.mass == 1.0f && chain.radius == 0.02f && chain.gravity_scale == 1.0f);
     ENSURE(chain.anchor == KDW_ANCHOR_VIEW_REFERENCE);
+    ENSURE(chain.collision_mask == 0xFFFFFFFFu && chain.friction == 0.3f);
+
+    kdw_collider_def collider = kdw_collider_def_default();
+    ENSURE(collider.struct_size == sizeof(kdw_collider_def));
+    ENSURE(collider.shape == KDW_COLLIDER_SPHERE && collider.radius == 0.1f && collider.half_height == 0.0f);
+    ENSURE(collider.layers == 1u);
+    ENSURE(v_length(collider.transform.position) == 0.0 && q_distance(collider.transform.rotation, q_identity()) == 0.0);
 
     kdw_engine *engine = engine_new(&def);
     ENSURE(engine != NULL);
@@ -575,6 +607,8 @@ static int test_defaults_and_settings(void)
     changed.iterations = 4;
     changed.substep_rate = 120.0f;
     changed.gravity = v3(0.0f, -1.62f, 0.0f);
+    changed.teleport_mode = KDW_TELEPORT_RESET;
+    changed.scale = 0.5f;
     ENSURE_OK(kdw_engine_set_def(engine, &changed));
     ENSURE_OK(kdw_engine_get_def(engine, &got));
     ENSURE(memcmp(&got, &changed, sizeof got) == 0);
@@ -596,6 +630,8 @@ static int test_defaults_and_settings(void)
     stiffer.damping = 3.0f;
     stiffer.gravity_scale = -0.5f;
     stiffer.anchor = KDW_ANCHOR_OWN;
+    stiffer.collision_mask = 0x5u;
+    stiffer.friction = 2.5f;
     ENSURE_OK(kdw_chain_set_def(engine, id, &stiffer));
     ENSURE_OK(kdw_chain_get_def(engine, id, &chain_got));
     ENSURE(memcmp(&chain_got, &stiffer, sizeof chain_got) == 0);
@@ -660,7 +696,7 @@ static int test_life_cycle(void)
     ENSURE(stats.substeps_last_step == 4);
     ENSURE(stats.substeps_total == (uint64_t)ORBIT_FRAMES * 4u);
     ENSURE(stats.chains_asleep <= stats.chain_count);
-    ENSURE(stats.reserved == 0);
+    ENSURE(stats.collider_count == 0 && stats.contact_pairs_tested == 0); /* no colliders, no contact cost */
     ENSURE(stats.solver_fallbacks == 0);
     ENSURE(stats.time_dropped == 0.0);
     ENSURE_SMALL(stats.simulated_time - ORBIT_FRAMES * (double)FRAME_DT, 1e-9);
@@ -1122,6 +1158,592 @@ static int test_non_unit_view_reference(void)
         ENSURE_SMALL(v_dist(a[j].position, b[j].position), 1e-5);
         ENSURE_SMALL(q_distance(a[j].rotation, b[j].rotation), 1e-5);
     }
+    return 0;
+}
+
+/* ---- colliders, per-joint radii, teleports, scale ------------------------------------------------------ */
+
+static kdw_collider_def collider_at(uint32_t shape, float radius, float half_height, kdw_vec3 position)
+{
+    kdw_collider_def def = kdw_collider_def_default();
+    def.shape = shape;
+    def.radius = radius;
+    def.half_height = half_height;
+    def.transform = xf(position, q_identity());
+    return def;
+}
+
+/* Collider ids in creation order must be exactly `expected`. */
+static int check_collider_ids(const kdw_engine *engine, const kdw_collider_id *expected, uint32_t count)
+{
+    kdw_collider_id listed[8];
+    uint32_t written = SENTINEL_U32, total = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_collider_count(engine, &total));
+    ENSURE(total == count);
+    ENSURE_OK(kdw_engine_get_collider_ids(engine, listed, 8, &written));
+    ENSURE(written == count);
+    for (uint32_t i = 0; i < count; ++i) {
+        uint32_t valid = SENTINEL_U32;
+        ENSURE(listed[i] == expected[i]);
+        ENSURE_OK(kdw_collider_is_valid(engine, listed[i], &valid));
+        ENSURE(valid == 1);
+    }
+    kdw_engine_stats stats;
+    ENSURE_OK(kdw_engine_get_stats(engine, &stats));
+    ENSURE(stats.collider_count == count);
+    return 0;
+}
+
+/* Create, list, destroy: ids are unique, of their own kind, stale after destruction (also once the slot is
+ * reused); the batched order is creation order with destroyed colliders left out. */
+static int test_collider_life_cycle(void)
+{
+    scene s, other;
+    ENSURE(scene_build(&s, 0) == 0);
+    ENSURE(scene_build(&other, 0) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_status ID = KDW_STATUS_INVALID_ID;
+    const kdw_collider_def sphere = collider_at(KDW_COLLIDER_SPHERE, 0.1f, 0.0f, v3(1.0f, 1.0f, 0.0f));
+    const kdw_collider_def capsule = collider_at(KDW_COLLIDER_CAPSULE, 0.05f, 0.2f, v3(-1.0f, 1.0f, 0.0f));
+    const kdw_collider_def plane = collider_at(KDW_COLLIDER_PLANE, 0.0f, 0.0f, v3(0.0f, -5.0f, 0.0f));
+    ENSURE(check_collider_ids(e, NULL, 0) == 0);
+
+    kdw_collider_id ids[3] = {0, 0, 0};
+    ENSURE_OK(kdw_collider_create(e, &sphere, &ids[0]));
+    ENSURE_OK(kdw_collider_create(e, &capsule, &ids[1]));
+    ENSURE_OK(kdw_collider_create(e, &plane, &ids[2]));
+    for (int i = 0; i < 3; ++i) {
+        ENSURE(ids[i] != 0 && ids[i] != ids[(i + 1) % 3]);
+        for (int c = 0; c < 3; ++c) {
+            ENSURE(ids[i] != s.chains[c]);
+        }
+    }
+    ENSURE(check_collider_ids(e, ids, 3) == 0);
+    ENSURE(step_frames(e, 0, 5) == 0);
+
+    uint64_t before = hash_of(e);
+    ENSURE_OK(kdw_collider_set_layers(e, ids[1], 0x6u));
+    ENSURE(hash_of(e) != before);
+
+    /* Destroying the middle one: the others keep their relative order. */
+    ENSURE_OK(kdw_collider_destroy(e, ids[1]));
+    const kdw_collider_id survivors[2] = {ids[0], ids[2]};
+    ENSURE(check_collider_ids(e, survivors, 2) == 0);
+    uint32_t valid = SENTINEL_U32;
+    ENSURE_OK(kdw_collider_is_valid(e, ids[1], &valid));
+    ENSURE(valid == 0);
+    ENSURE_REJECTED(e, kdw_collider_destroy(e, ids[1]), ID);
+    ENSURE_REJECTED(e, kdw_collider_set_layers(e, ids[1], 1u), ID);
+    ENSURE_REJECTED(e, kdw_collider_destroy(e, 0), ID);
+
+    /* Ids of one kind are never ids of another. */
+    ENSURE_OK(kdw_collider_is_valid(e, s.chains[0], &valid));
+    ENSURE(valid == 0);
+    ENSURE_OK(kdw_chain_is_valid(e, ids[0], &valid));
+    ENSURE(valid == 0);
+    ENSURE_REJECTED(e, kdw_collider_destroy(e, s.chains[0]), ID);
+    ENSURE_REJECTED(e, kdw_collider_set_layers(e, s.chains[1], 1u), ID);
+    ENSURE_REJECTED(e, kdw_chain_destroy(e, ids[0]), ID);
+    ENSURE_REJECTED(e, kdw_chain_teleport(e, ids[0]), ID);
+    const float radii[8] = {0};
+    ENSURE_REJECTED(e, kdw_chain_set_joint_radii(e, ids[2], radii, 8), ID);
+
+    /* A foreign id is rejected here and fine on its own engine. */
+    kdw_collider_id foreign = 0;
+    ENSURE_OK(kdw_collider_create(other.engine, &sphere, &foreign));
+    ENSURE_OK(kdw_collider_is_valid(e, foreign, &valid));
+    ENSURE(valid == 0);
+    ENSURE_REJECTED(e, kdw_collider_destroy(e, foreign), ID);
+    ENSURE_REJECTED(e, kdw_collider_set_layers(e, foreign, 2u), ID);
+    ENSURE_OK(kdw_collider_is_valid(other.engine, foreign, &valid));
+    ENSURE(valid == 1);
+
+    /* A new collider comes last (reusing the freed slot); the old id stays stale. */
+    kdw_collider_id again = 0;
+    ENSURE_OK(kdw_collider_create(e, &capsule, &again));
+    ENSURE(again != 0 && again != ids[1]);
+    const kdw_collider_id reordered[3] = {ids[0], ids[2], again};
+    ENSURE(check_collider_ids(e, reordered, 3) == 0);
+    ENSURE_REJECTED(e, kdw_collider_destroy(e, ids[1]), ID);
+
+    /* Too small a buffer: nothing written. */
+    kdw_collider_id listed[3];
+    memset(listed, SENTINEL_BYTE, sizeof listed);
+    uint32_t written = SENTINEL_U32;
+    ENSURE_REJECTED(e, kdw_engine_get_collider_ids(e, listed, 2, &written), KDW_STATUS_BUFFER_TOO_SMALL);
+    ENSURE_REJECTED(e, kdw_engine_get_collider_ids(e, NULL, 0, &written), KDW_STATUS_BUFFER_TOO_SMALL);
+    ENSURE_REJECTED(e, kdw_engine_get_collider_ids(e, NULL, 3, &written), KDW_STATUS_NULL_POINTER);
+    ENSURE(written == SENTINEL_U32 && bytes_are(listed, sizeof listed, SENTINEL_BYTE));
+
+    /* Every collider call rejects a NULL engine. */
+    const kdw_status NP = KDW_STATUS_NULL_POINTER;
+    kdw_collider_id id_out = SENTINEL_U64;
+    uint32_t u = SENTINEL_U32;
+    const kdw_transform poses[3] = {sphere.transform, plane.transform, capsule.transform};
+    ENSURE_REJECTED(e, kdw_collider_create(NULL, &sphere, &id_out), NP);
+    ENSURE_REJECTED(e, kdw_collider_create(e, NULL, &id_out), NP);
+    ENSURE_REJECTED(e, kdw_collider_create(e, &sphere, NULL), NP);
+    ENSURE_REJECTED(e, kdw_collider_destroy(NULL, ids[0]), NP);
+    ENSURE_REJECTED(e, kdw_collider_is_valid(NULL, ids[0], &u), NP);
+    ENSURE_REJECTED(e, kdw_collider_is_valid(e, ids[0], NULL), NP);
+    ENSURE_REJECTED(e, kdw_collider_set_layers(NULL, ids[0], 1u), NP);
+    ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(NULL, poses, 3), NP);
+    ENSURE_REJECTED(e, kdw_engine_collider_count(NULL, &u), NP);
+    ENSURE_REJECTED(e, kdw_engine_collider_count(e, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_get_collider_ids(NULL, listed, 3, &u), NP);
+    ENSURE_REJECTED(e, kdw_engine_teleport(NULL), NP);
+    ENSURE_REJECTED(e, kdw_chain_teleport(NULL, s.chains[0]), NP);
+    ENSURE_REJECTED(e, kdw_chain_set_joint_radii(NULL, s.chains[0], radii, 8), NP);
+    ENSURE(id_out == SENTINEL_U64 && u == SENTINEL_U32);
+
+    /* Without colliders, zero poses (NULL allowed) is the right count. */
+    for (int i = 0; i < 3; ++i) {
+        ENSURE_OK(kdw_collider_destroy(e, reordered[i]));
+    }
+    ENSURE(check_collider_ids(e, NULL, 0) == 0);
+    ENSURE_OK(kdw_engine_set_collider_transforms(e, NULL, 0));
+    ENSURE(step_frames(e, 5, 1) == 0);
+    return 0;
+}
+
+/* Every way a collider def can be wrong is rejected before anything changes. */
+static int test_error_collider_def(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 0) == 0);
+    ENSURE(step_frames(s.engine, 0, 5) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_collider_def good = collider_at(KDW_COLLIDER_CAPSULE, 0.05f, 0.1f, v3(0.5f, 1.0f, 0.0f));
+    kdw_collider_id out = SENTINEL_U64;
+
+    const uint32_t bad_sizes[] = {0, (uint32_t)sizeof(kdw_collider_def) - 4, (uint32_t)sizeof(kdw_collider_def) + 4};
+    for (size_t i = 0; i < sizeof bad_sizes / sizeof bad_sizes[0]; ++i) {
+        kdw_collider_def def = good;
+        def.struct_size = bad_sizes[i];
+        ENSURE_REJECTED(e, kdw_collider_create(e, &def, &out), KDW_STATUS_STRUCT_SIZE_MISMATCH);
+    }
+
+    kdw_collider_def bad[24];
+    int n = 0;
+    for (int i = 0; i < 24; ++i) {
+        bad[i] = good;
+    }
+    bad[n++].radius = NAN;
+    bad[n++].radius = INFINITY;
+    bad[n++].radius = -0.01f;
+    bad[n++].radius = 2e6f;
+    bad[n++].half_height = NAN;
+    bad[n++].half_height = -INFINITY;
+    bad[n++].half_height = -0.01f;
+    bad[n].radius = 0.0f; /* a capsule of no size */
+    bad[n++].half_height = 0.0f;
+    bad[n++] = collider_at(KDW_COLLIDER_INSIDE_SPHERE, 0.0f, 0.0f, v3(0.0f, 1.0f, 0.0f));
+    bad[n++] = collider_at(KDW_COLLIDER_INSIDE_CAPSULE, 0.0f, 0.1f, v3(0.0f, 1.0f, 0.0f));
+    bad[n++] = collider_at(KDW_COLLIDER_SPHERE, -1.0f, 0.0f, v3(0.0f, 1.0f, 0.0f));
+    bad[n++].shape = 5;
+    bad[n++].shape = 0xFFFFFFFFu;
+    bad[n++].transform.position.x = NAN;
+    bad[n++].transform.position.z = -INFINITY;
+    bad[n++].transform.position.y = 2e9f;
+    bad[n++].transform.rotation.w = NAN;
+    bad[n++].transform.rotation.y = INFINITY;
+    bad[n++].transform.rotation = q4(0.0f, 0.0f, 0.0f, 0.0f);
+    for (int i = 0; i < n; ++i) {
+        ENSURE_REJECTED(e, kdw_collider_create(e, &bad[i], &out), KDW_STATUS_INVALID_ARGUMENT);
+    }
+    ENSURE(out == SENTINEL_U64);
+    ENSURE(check_collider_ids(e, NULL, 0) == 0);
+
+    /* the edges of the ranges are accepted: a point-like sphere, a segment capsule, a non-unit rotation */
+    kdw_collider_def edge = collider_at(KDW_COLLIDER_SPHERE, 0.0f, 0.0f, v3(0.5f, 1.0f, 0.0f));
+    ENSURE_OK(kdw_collider_create(e, &edge, &out));
+    edge = collider_at(KDW_COLLIDER_CAPSULE, 0.0f, 0.1f, v3(0.5f, 1.0f, 0.0f));
+    edge.transform.rotation = q4(0.0f, 0.0f, 2.0f, 2.0f);
+    ENSURE_OK(kdw_collider_create(e, &edge, &out));
+    ENSURE_OK(kdw_collider_create(e, &good, &out));
+    return 0;
+}
+
+/* The batched collider poses and the per-joint radii validate everything before changing anything. */
+static int test_error_collider_transforms_and_joint_radii(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 0) == 0);
+    kdw_engine *e = s.engine;
+    const kdw_collider_def sphere = collider_at(KDW_COLLIDER_SPHERE, 0.1f, 0.0f, v3(1.0f, 1.0f, 0.0f));
+    kdw_collider_id ids[2];
+    ENSURE_OK(kdw_collider_create(e, &sphere, &ids[0]));
+    ENSURE_OK(kdw_collider_create(e, &sphere, &ids[1]));
+    ENSURE(step_frames(e, 0, 10) == 0);
+    const kdw_status IA = KDW_STATUS_INVALID_ARGUMENT;
+
+    kdw_transform poses[3] = {xf(v3(1.0f, 1.1f, 0.0f), q_identity()), xf(v3(-1.0f, 1.1f, 0.0f), q_identity()),
+                              xf(v3(0.0f, 3.0f, 0.0f), q_identity())};
+    /* one pose per collider: not fewer, not more */
+    ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(e, poses, 1), IA);
+    ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(e, poses, 3), IA);
+    ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(e, NULL, 0), IA);
+    ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(e, NULL, 2), KDW_STATUS_NULL_POINTER);
+    /* every pose is checked, the last one too */
+    const kdw_transform good[2] = {poses[0], poses[1]};
+    for (int slot = 0; slot < 2; ++slot) {
+        kdw_transform broken[2] = {good[0], good[1]};
+        broken[slot].position.x = NAN;
+        ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(e, broken, 2), IA);
+        broken[slot] = good[slot];
+        broken[slot].position.y = INFINITY;
+        ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(e, broken, 2), IA);
+        broken[slot] = good[slot];
+        broken[slot].position.z = -2e9f;
+        ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(e, broken, 2), IA);
+        broken[slot] = good[slot];
+        broken[slot].rotation.x = -INFINITY;
+        ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(e, broken, 2), IA);
+        broken[slot] = good[slot];
+        broken[slot].rotation = q4(0.0f, 0.0f, 0.0f, 0.0f);
+        ENSURE_REJECTED(e, kdw_engine_set_collider_transforms(e, broken, 2), IA);
+    }
+    /* the valid call is part of the state (it decides the next step) */
+    uint64_t before = hash_of(e);
+    ENSURE_OK(kdw_engine_set_collider_transforms(e, good, 2));
+    ENSURE(hash_of(e) != before);
+
+    /* per-joint radii: one per joint (the ahoge has 8), each finite in [0, 1e6] */
+    const kdw_chain_id chain = s.chains[0];
+    float radii[9] = {0.01f, 0.01f, 0.01f, 0.01f, 0.01f, 0.01f, 0.01f, 0.01f, 0.01f};
+    ENSURE_REJECTED(e, kdw_chain_set_joint_radii(e, chain, radii, 7), IA);
+    ENSURE_REJECTED(e, kdw_chain_set_joint_radii(e, chain, radii, 9), IA);
+    ENSURE_REJECTED(e, kdw_chain_set_joint_radii(e, chain, radii, 1), IA);
+    ENSURE_REJECTED(e, kdw_chain_set_joint_radii(e, chain, NULL, 8), KDW_STATUS_NULL_POINTER);
+    const float bad_values[] = {NAN, INFINITY, -INFINITY, -0.01f, 2e6f};
+    for (size_t i = 0; i < sizeof bad_values / sizeof bad_values[0]; ++i) {
+        radii[7] = bad_values[i];
+        ENSURE_REJECTED(e, kdw_chain_set_joint_radii(e, chain, radii, 8), IA);
+        radii[7] = 0.01f;
+        radii[0] = bad_values[i];
+        ENSURE_REJECTED(e, kdw_chain_set_joint_radii(e, chain, radii, 8), IA);
+        radii[0] = 0.01f;
+    }
+    before = hash_of(e);
+    ENSURE_OK(kdw_chain_set_joint_radii(e, chain, radii, 8));
+    ENSURE(hash_of(e) != before);
+    ENSURE_OK(kdw_chain_set_joint_radii(e, chain, NULL, 0)); /* back to the def's radius */
+    return 0;
+}
+
+#define DRAPE_JOINTS 8
+#define BALL_RADIUS 0.1f
+
+/* A limp 8-joint chain held level at (0, 1, 0) along +x, 5 cm apart, falling onto a ball below its middle. */
+static int drape_scene(kdw_engine **out, uint32_t collision_mask, kdw_chain_id *chain, kdw_collider_id *ball,
+                       kdw_vec3 ball_centre)
+{
+    kdw_engine *e = engine_new_default();
+    ENSURE(e != NULL);
+    chain_spec level;
+    make_straight(&level, DRAPE_JOINTS, v3(0.0f, 0.0f, 0.0f), v3(1.0f, 0.0f, 0.0f), 0.05f);
+    kdw_chain_def def = kdw_chain_def_default();
+    def.stiffness = 0.02f;
+    def.damping = 3.0f;
+    def.collision_mask = collision_mask;
+    ENSURE_OK(kdw_chain_create(e, &def, level.joints, level.n, chain));
+    const float zero_radii[DRAPE_JOINTS] = {0};
+    ENSURE_OK(kdw_chain_set_joint_radii(e, *chain, zero_radii, DRAPE_JOINTS));
+    kdw_collider_def sphere = collider_at(KDW_COLLIDER_SPHERE, BALL_RADIUS, 0.0f, ball_centre);
+    sphere.layers = 0x2u;
+    ENSURE_OK(kdw_collider_create(e, &sphere, ball));
+    *out = e;
+    return 0;
+}
+
+/* Smallest distance of the chain's joints to `centre` (read through kdw_chain_read_world). */
+static int closest_joint(const kdw_engine *e, kdw_chain_id chain, kdw_vec3 centre, double *closest)
+{
+    kdw_transform world[DRAPE_JOINTS];
+    uint32_t written = 0;
+    ENSURE_OK(kdw_chain_read_world(e, chain, world, DRAPE_JOINTS, &written));
+    ENSURE(written == DRAPE_JOINTS);
+    *closest = 1e30;
+    for (uint32_t j = 0; j < written; ++j) {
+        ENSURE(v_is_finite(world[j].position));
+        *closest = fmin(*closest, v_dist(world[j].position, centre));
+    }
+    return 0;
+}
+
+/* A chain falling onto a sphere collider stays outside it in every frame (joint radius 0: the joints
+ * themselves), rests on it, is pushed by it when it moves, and keeps its joint radius off it once the def's
+ * radius applies again. The same chain with a collision mask that misses the ball falls through it. */
+static int test_chain_stays_outside_sphere_collider(void)
+{
+    const kdw_transform anchor = xf(v3(0.0f, 1.0f, 0.0f), q_identity());
+    const kdw_vec3 camera = v3(0.0f, 1.0f, 3.0f);
+    kdw_vec3 centre = v3(0.2f, 0.82f, 0.0f);
+    kdw_engine *e = NULL, *through = NULL;
+    kdw_chain_id chain = 0, ghost = 0;
+    kdw_collider_id ball = 0, ghost_ball = 0;
+    ENSURE(drape_scene(&e, 0x3u, &chain, &ball, centre) == 0);
+    ENSURE(drape_scene(&through, 0x1u, &ghost, &ghost_ball, centre) == 0);
+
+    double resting = 1e30, ghost_closest = 1e30;
+    for (int frame = 0; frame < 180; ++frame) {
+        ENSURE_OK(kdw_engine_step(e, FRAME_DT, &camera, &anchor));
+        ENSURE_OK(kdw_engine_step(through, FRAME_DT, &camera, &anchor));
+        double closest = 0.0, other = 0.0;
+        ENSURE(closest_joint(e, chain, centre, &closest) == 0);
+        ENSURE(closest_joint(through, ghost, centre, &other) == 0);
+        if (!(closest >= BALL_RADIUS - 1e-4)) {
+            printf("    frame %d: a joint is %.6f m from the ball's centre (radius %.3f)\n", frame, closest,
+                   (double)BALL_RADIUS);
+            return 1;
+        }
+        resting = closest;
+        ghost_closest = fmin(ghost_closest, other);
+    }
+    /* It lies on the ball rather than stopping above it. Segments collide too, so a segment can rest tangent to
+     * the ball with its joints sqrt(0.1^2 + 0.025^2) - 0.1 = 3.1 mm out. */
+    ENSURE(resting < BALL_RADIUS + 3.5e-3);
+    ENSURE(ghost_closest < BALL_RADIUS - 0.05); /* without the ball's layer it falls right through */
+    kdw_engine_stats stats;
+    ENSURE_OK(kdw_engine_get_stats(e, &stats));
+    ENSURE(stats.collider_count == 1 && stats.contact_pairs_tested > 0);
+
+    /* The ball rises 6 cm over one second, one batched pose per frame: the chain is pushed along. */
+    for (int frame = 0; frame < 60; ++frame) {
+        centre.y += 0.001f;
+        const kdw_transform pose = xf(centre, q_identity());
+        ENSURE_OK(kdw_engine_set_collider_transforms(e, &pose, 1));
+        ENSURE_OK(kdw_engine_step(e, FRAME_DT, &camera, &anchor));
+        double closest = 0.0;
+        ENSURE(closest_joint(e, chain, centre, &closest) == 0);
+        ENSURE(closest >= BALL_RADIUS - 1e-4);
+    }
+
+    /* Back to the def's radius (0.02 m): the joints settle that much farther out. */
+    ENSURE_OK(kdw_chain_set_joint_radii(e, chain, NULL, 0));
+    double closest = 0.0;
+    for (int frame = 0; frame < 60; ++frame) {
+        ENSURE_OK(kdw_engine_step(e, FRAME_DT, &camera, &anchor));
+    }
+    ENSURE(closest_joint(e, chain, centre, &closest) == 0);
+    ENSURE(closest >= BALL_RADIUS + 0.02 - 1e-3 && closest < BALL_RADIUS + 0.02 + 5e-3);
+    return 0;
+}
+
+/* Engines for the teleport tests: a side lock and a tail on the head, automatic teleports off (FLT_MAX), so
+ * that only the explicit calls teleport. */
+static kdw_engine *teleport_engine(uint32_t mode, kdw_chain_id chains[2])
+{
+    kdw_engine_def def = kdw_engine_def_default();
+    def.teleport_distance = FLT_MAX;
+    def.teleport_mode = mode;
+    kdw_engine *e = engine_new(&def);
+    if (e == NULL) return NULL;
+    kdw_chain_def chain = kdw_chain_def_default();
+    if (kdw_chain_create(e, &chain, g_side_lock.joints, g_side_lock.n, &chains[0]) != KDW_STATUS_OK ||
+        kdw_chain_create(e, &chain, g_tail.joints, g_tail.n, &chains[1]) != KDW_STATUS_OK) {
+        printf("    chain create failed: %s\n", harness_last_error());
+        return NULL;
+    }
+    return e;
+}
+
+/* The head swings for 20 frames, then holds still (the chains keep swinging), offset by `jump` from frame 30. */
+static kdw_transform swinging_head(int frame, kdw_vec3 jump)
+{
+    int swing = frame < 20 ? frame : 19;
+    kdw_transform head = xf(v3(0.15f * sinf(0.3f * (float)swing), 1.6f, 0.0f), q_identity());
+    if (frame >= 30) head.position = v_add(head.position, jump);
+    return head;
+}
+
+static int step_swinging(kdw_engine *e, int frame, kdw_vec3 jump)
+{
+    kdw_transform head = swinging_head(frame, jump);
+    kdw_vec3 camera = v_add(v3(0.0f, 1.7f, 3.0f), frame >= 30 ? jump : v3(0.0f, 0.0f, 0.0f));
+    ENSURE_OK(kdw_engine_step(e, FRAME_DT, &camera, &head));
+    return 0;
+}
+
+static int chain_energy(const kdw_engine *e, kdw_chain_id chain, double *energy)
+{
+    float value = -1.0f;
+    ENSURE_OK(kdw_chain_kinetic_energy(e, chain, &value));
+    ENSURE(isfinite(value) && value >= 0.0f);
+    *energy = value;
+    return 0;
+}
+
+/* kdw_engine_teleport (carry mode) takes the chains through a 100 m jump as if nothing happened: relative to
+ * the head their poses and energies equal those of an engine whose head did not jump. The same jump without
+ * the call whips them; kdw_chain_teleport spares only its own chain. */
+static int test_engine_teleport_carries_chains(void)
+{
+    kdw_chain_id a[2], still[2], whipped[2], one[2];
+    kdw_engine *jumper = teleport_engine(KDW_TELEPORT_CARRY_SHAPE, a);
+    kdw_engine *reference = teleport_engine(KDW_TELEPORT_CARRY_SHAPE, still);
+    kdw_engine *no_call = teleport_engine(KDW_TELEPORT_CARRY_SHAPE, whipped);
+    kdw_engine *chain_call = teleport_engine(KDW_TELEPORT_CARRY_SHAPE, one);
+    ENSURE(jumper != NULL && reference != NULL && no_call != NULL && chain_call != NULL);
+    const kdw_vec3 jump = v3(100.0f, 0.0f, 0.0f), none = v3(0.0f, 0.0f, 0.0f);
+
+    for (int frame = 0; frame < 60; ++frame) {
+        if (frame == 30) {
+            uint64_t before = hash_of(jumper);
+            ENSURE_OK(kdw_engine_teleport(jumper));
+            ENSURE(hash_of(jumper) != before); /* the request is state until the next step */
+            ENSURE_OK(kdw_chain_teleport(chain_call, one[0]));
+        }
+        ENSURE(step_swinging(jumper, frame, jump) == 0);
+        ENSURE(step_swinging(reference, frame, none) == 0);
+        ENSURE(step_swinging(no_call, frame, jump) == 0);
+        ENSURE(step_swinging(chain_call, frame, jump) == 0);
+        if (frame < 30) continue;
+
+        const kdw_vec3 head_a = swinging_head(frame, jump).position, head_b = swinging_head(frame, none).position;
+        kdw_transform wa[MAX_TOTAL], wb[MAX_TOTAL], wc[MAX_TOTAL];
+        uint32_t na = 0, nb = 0, nc = 0;
+        ENSURE_OK(kdw_engine_read_world(jumper, wa, MAX_TOTAL, &na));
+        ENSURE_OK(kdw_engine_read_world(reference, wb, MAX_TOTAL, &nb));
+        ENSURE_OK(kdw_engine_read_world(chain_call, wc, MAX_TOTAL, &nc));
+        ENSURE(na == nb && nb == nc && na == g_side_lock.n + g_tail.n);
+        for (uint32_t j = 0; j < na; ++j) {
+            ENSURE_SMALL(v_dist(v_sub(wa[j].position, head_a), v_sub(wb[j].position, head_b)), 1e-4);
+            ENSURE_SMALL(q_distance(wa[j].rotation, wb[j].rotation), 1e-4);
+        }
+        for (uint32_t j = 0; j < g_side_lock.n; ++j) { /* the chain told to teleport */
+            ENSURE_SMALL(v_dist(v_sub(wc[j].position, head_a), v_sub(wb[j].position, head_b)), 1e-4);
+        }
+        for (int c = 0; c < 2; ++c) {
+            double ka = 0.0, kb = 0.0, kw = 0.0, k1 = 0.0;
+            ENSURE(chain_energy(jumper, a[c], &ka) == 0);
+            ENSURE(chain_energy(reference, still[c], &kb) == 0);
+            ENSURE(chain_energy(no_call, whipped[c], &kw) == 0);
+            ENSURE(chain_energy(chain_call, one[c], &k1) == 0);
+            ENSURE_SMALL(ka - kb, 1e-3 * kb + 1e-7); /* carried: no energy added, none lost */
+            if (frame == 30) {
+                ENSURE(kb > 1e-5);             /* the chains were still swinging: the comparison means something */
+                ENSURE(kw > 1000.0 * kb);       /* dragged 100 m in one frame */
+                if (c == 0) ENSURE_SMALL(k1 - kb, 1e-3 * kb + 1e-7);
+                else ENSURE(k1 > 1000.0 * kb); /* the other chain was not told to teleport */
+            }
+        }
+    }
+    return 0;
+}
+
+/* KDW_TELEPORT_RESET: a teleported chain is put back to its rest shape under its new anchor, at rest, i.e.
+ * exactly what kdw_chain_reset / kdw_engine_reset do at the same step (same state hash, same read-back). */
+static int test_teleport_mode_reset(void)
+{
+    kdw_chain_id a[2], r[2], carried[2];
+    kdw_engine *teleported = teleport_engine(KDW_TELEPORT_RESET, a);
+    kdw_engine *reset = teleport_engine(KDW_TELEPORT_RESET, r);
+    kdw_engine *carry = teleport_engine(KDW_TELEPORT_CARRY_SHAPE, carried);
+    ENSURE(teleported != NULL && reset != NULL && carry != NULL);
+    const kdw_vec3 jump = v3(3.0f, 0.5f, -2.0f);
+    for (int frame = 0; frame < 50; ++frame) {
+        if (frame == 30) { /* one chain */
+            ENSURE_OK(kdw_chain_teleport(teleported, a[0]));
+            ENSURE_OK(kdw_chain_reset(reset, r[0]));
+            ENSURE_OK(kdw_chain_teleport(carry, carried[0]));
+        }
+        if (frame == 40) { /* every chain, no jump this time: a teleport however small */
+            ENSURE_OK(kdw_engine_teleport(teleported));
+            ENSURE_OK(kdw_engine_reset(reset));
+        }
+        ENSURE(step_swinging(teleported, frame, jump) == 0);
+        ENSURE(step_swinging(reset, frame, jump) == 0);
+        ENSURE(step_swinging(carry, frame, jump) == 0);
+        ENSURE(hash_of(teleported) == hash_of(reset));
+        kdw_transform wa[MAX_TOTAL], wr[MAX_TOTAL];
+        uint32_t na = 0, nr = 0;
+        ENSURE_OK(kdw_engine_read_world(teleported, wa, MAX_TOTAL, &na));
+        ENSURE_OK(kdw_engine_read_world(reset, wr, MAX_TOTAL, &nr));
+        ENSURE(na == nr && memcmp(wa, wr, na * sizeof wa[0]) == 0);
+        if (frame == 30) {
+            double reset_energy = 0.0, carried_energy = 0.0;
+            ENSURE(chain_energy(teleported, a[0], &reset_energy) == 0);
+            ENSURE(chain_energy(carry, carried[0], &carried_energy) == 0);
+            ENSURE(carried_energy > 10.0 * reset_energy); /* the reset one starts again from rest */
+        }
+    }
+    return 0;
+}
+
+/* The engine's scale: validated ([1e-6, 1e6], finite), and a character 100 times larger with scale 100 moves
+ * exactly like the original, 100 times larger, collisions included (radii scale, collider sizes do not). */
+static int test_engine_scale(void)
+{
+    scene s; /* target of set_def, witness for create */
+    ENSURE(scene_build(&s, 0) == 0);
+    ENSURE(step_frames(s.engine, 0, 5) == 0);
+    kdw_engine *const marker = (kdw_engine *)(void *)&s;
+    kdw_engine *out = marker;
+    const float bad_scales[] = {0.0f, -1.0f, 1e-7f, 1e7f, NAN, INFINITY, -INFINITY};
+    for (size_t i = 0; i < sizeof bad_scales / sizeof bad_scales[0]; ++i) {
+        kdw_engine_def def = kdw_engine_def_default();
+        def.scale = bad_scales[i];
+        ENSURE_REJECTED(s.engine, kdw_engine_create(&def, &out), KDW_STATUS_INVALID_ARGUMENT);
+        ENSURE_REJECTED(s.engine, kdw_engine_set_def(s.engine, &def), KDW_STATUS_INVALID_ARGUMENT);
+    }
+    const uint32_t bad_modes[] = {2u, 7u, 0xFFFFFFFFu};
+    for (size_t i = 0; i < sizeof bad_modes / sizeof bad_modes[0]; ++i) {
+        kdw_engine_def def = kdw_engine_def_default();
+        def.teleport_mode = bad_modes[i];
+        ENSURE_REJECTED(s.engine, kdw_engine_create(&def, &out), KDW_STATUS_INVALID_ARGUMENT);
+        ENSURE_REJECTED(s.engine, kdw_engine_set_def(s.engine, &def), KDW_STATUS_INVALID_ARGUMENT);
+    }
+    ENSURE(out == marker);
+    const float edge_scales[] = {1e-6f, 1e6f};
+    for (size_t i = 0; i < 2; ++i) {
+        kdw_engine_def def = kdw_engine_def_default();
+        def.scale = edge_scales[i];
+        kdw_engine *edge = engine_new(&def);
+        ENSURE(edge != NULL);
+        ENSURE_OK(engine_free(edge));
+    }
+
+    /* Same scene at 1x and 100x. */
+    kdw_engine *engines[2];
+    kdw_chain_id chains[2];
+    const float sizes[2] = {1.0f, 100.0f};
+    for (int k = 0; k < 2; ++k) {
+        kdw_engine_def def = kdw_engine_def_default();
+        def.scale = sizes[k];
+        engines[k] = engine_new(&def);
+        ENSURE(engines[k] != NULL);
+        chain_spec lock = g_side_lock;
+        for (uint32_t j = 0; j < lock.n; ++j) {
+            lock.joints[j].position = v_scale(lock.joints[j].position, sizes[k]);
+        }
+        kdw_chain_def chain = kdw_chain_def_default();
+        ENSURE_OK(kdw_chain_create(engines[k], &chain, lock.joints, lock.n, &chains[k]));
+        /* a ball in the lock's way, world units */
+        kdw_collider_def ball = collider_at(KDW_COLLIDER_SPHERE, 0.03f * sizes[k], 0.0f,
+                                           v_scale(v3(0.1f, 1.5f, 0.06f), sizes[k]));
+        kdw_collider_id id = 0;
+        ENSURE_OK(kdw_collider_create(engines[k], &ball, &id));
+    }
+    for (int frame = 0; frame < 90; ++frame) {
+        kdw_transform world[2][MAX_JOINTS];
+        for (int k = 0; k < 2; ++k) {
+            kdw_transform head = swinging_head(frame, v3(0.0f, 0.0f, 0.0f));
+            head.position = v_scale(head.position, sizes[k]);
+            kdw_vec3 camera = v_scale(v3(0.0f, 1.7f, 3.0f), sizes[k]);
+            ENSURE_OK(kdw_engine_step(engines[k], FRAME_DT, &camera, &head));
+            uint32_t written = 0;
+            ENSURE_OK(kdw_chain_read_world(engines[k], chains[k], world[k], MAX_JOINTS, &written));
+            ENSURE(written == g_side_lock.n);
+        }
+        for (uint32_t j = 0; j < g_side_lock.n; ++j) {
+            ENSURE_SMALL(v_dist(v_scale(world[1][j].position, 0.01f), world[0][j].position), 1e-4);
+            ENSURE_SMALL(q_distance(world[1][j].rotation, world[0][j].rotation), 1e-4);
+        }
+    }
+    kdw_engine_stats stats;
+    ENSURE_OK(kdw_engine_get_stats(engines[1], &stats));
+    ENSURE(stats.contact_pairs_tested > 0);
     return 0;
 }
 
@@ -1781,6 +2403,11 @@ int main(void)
     RUN_TEST(test_teleport_camera_on_head_and_new_base);
     RUN_TEST(test_dt_zero_changes_nothing);
     RUN_TEST(test_non_unit_view_reference);
+    RUN_TEST(test_collider_life_cycle);
+    RUN_TEST(test_chain_stays_outside_sphere_collider);
+    RUN_TEST(test_engine_teleport_carries_chains);
+    RUN_TEST(test_teleport_mode_reset);
+    RUN_TEST(test_engine_scale);
     RUN_TEST(test_error_null_engine);
     RUN_TEST(test_error_null_out_pointers);
     RUN_TEST(test_error_null_inputs);
@@ -1790,6 +2417,8 @@ int main(void)
     RUN_TEST(test_error_view_shapes);
     RUN_TEST(test_error_chain_def);
     RUN_TEST(test_error_engine_def);
+    RUN_TEST(test_error_collider_def);
+    RUN_TEST(test_error_collider_transforms_and_joint_radii);
     RUN_TEST(test_error_buffers);
     RUN_TEST(test_last_error_message);
     RUN_TEST(test_sketch_layout_and_defaults);

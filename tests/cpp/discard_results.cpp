@@ -3,8 +3,10 @@
 #include "kodawari.hpp"
 
 void discard_everything(kodawari::Engine& engine, kodawari::ViewDependentPhysicalObject chain,
-                        kodawari::ViewShape shape) {
+                        kodawari::ViewShape shape, kodawari::Collider collider) {
     engine.chainCount();                     // DISCARD
+    engine.colliderCount();                  // DISCARD
+    collider.isValid();                      // DISCARD
     engine.stateHash();                      // DISCARD
     chain.jointCount();                      // DISCARD
     chain.isValid();                         // DISCARD
@@ -14,6 +16,10 @@ void discard_everything(kodawari::Engine& engine, kodawari::ViewDependentPhysica
     engine.reset();                          // DISCARD
     chain.destroy();                         // DISCARD
     shape.remove();                          // DISCARD
+    engine.teleport();                       // DISCARD
+    engine.setColliderTransforms(nullptr, 0);  // DISCARD
+    chain.teleport();                        // DISCARD
+    collider.destroy();                      // DISCARD
 #else
     (void)shape;
 #endif

@@ -40,6 +40,8 @@ void run_no_exception_tests();  // test_no_exceptions.cpp
 namespace {
 
 using kodawari::ChainDef;
+using kodawari::Collider;
+using kodawari::ColliderDef;
 using kodawari::Engine;
 using kodawari::EngineDef;
 using kodawari::Transform;
@@ -72,6 +74,8 @@ static_assert(std::is_nothrow_move_constructible_v<Engine> && std::is_nothrow_mo
 static_assert(std::is_nothrow_destructible_v<Engine>);
 static_assert(std::is_constructible_v<bool, Engine> && !std::is_convertible_v<Engine, bool>);
 static_assert(std::is_trivially_copyable_v<ViewDependentPhysicalObject> && std::is_trivially_copyable_v<ViewShape>);
+static_assert(std::is_trivially_copyable_v<Collider> && std::is_same_v<kodawari::Ret<Collider>, Collider>);
+static_assert(std::is_base_of_v<kdw_collider_def, ColliderDef> && sizeof(ColliderDef) == sizeof(kdw_collider_def));
 static_assert(std::is_base_of_v<std::runtime_error, kodawari::Error>);
 static_assert(std::is_base_of_v<kdw_engine_def, EngineDef> && sizeof(EngineDef) == sizeof(kdw_engine_def));
 static_assert(std::is_base_of_v<kdw_chain_def, ChainDef> && sizeof(ChainDef) == sizeof(kdw_chain_def));
@@ -90,6 +94,14 @@ void test_defaults_and_versions() {
     const kdw_chain_def c_chain_def = kdw_chain_def_default();
     CHECK(std::memcmp(&chain_def, &c_chain_def, sizeof c_chain_def) == 0);
     CHECK(chain_def.struct_size == sizeof(kdw_chain_def));
+    const ColliderDef collider_def;
+    const kdw_collider_def c_collider_def = kdw_collider_def_default();
+    CHECK(std::memcmp(&collider_def, &c_collider_def, sizeof c_collider_def) == 0);
+    const ColliderDef capsule = ColliderDef::capsule(0.05f, 0.2f, Transform{{1.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f, 1.0f}});
+    CHECK(capsule.shape == KDW_COLLIDER_CAPSULE && capsule.radius == 0.05f && capsule.half_height == 0.2f);
+    CHECK(capsule.transform.position.z == 3.0f && capsule.layers == c_collider_def.layers);
+    CHECK(engine_def.teleport_mode == KDW_TELEPORT_CARRY_SHAPE && engine_def.scale == 1.0f);
+    CHECK(chain_def.collision_mask == 0xFFFFFFFFu && chain_def.friction == 0.3f);
     CHECK(kodawari::abiVersion() == KDW_ABI_VERSION);
     CHECK(std::string(kodawari::versionString()).size() > 0);
     CHECK(std::string(kodawari::statusString(KDW_STATUS_INVALID_ID)) == kdw_status_str(KDW_STATUS_INVALID_ID));
@@ -452,6 +464,171 @@ void test_shape_from_stroke() {
     CHECK_THROWS(behind.project(current[0].position), KDW_STATUS_INVALID_ARGUMENT);
 }
 
+float distance(const kodawari::Vec3& a, const kodawari::Vec3& b) {
+    return std::sqrt((a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y) + (a.z - b.z) * (a.z - b.z));
+}
+
+const kodawari::Quat kIdentity{0.0f, 0.0f, 0.0f, 1.0f};
+
+// Colliders through the RAII layer: a limp chain (joint radii 0) draped over a ball stays outside it every
+// frame while the ball's pose is set in one batched call; rejected inputs throw and change nothing; a ball
+// moved off the chain's layers lets it fall through; destroyed and wrong-kind ids throw INVALID_ID.
+void test_colliders_and_joint_radii() {
+    Engine engine{EngineDef()};
+    std::vector<Transform> level;
+    for (int j = 0; j < 8; ++j) level.push_back(Transform{{0.05f * static_cast<float>(j), 0.0f, 0.0f}, kIdentity});
+    ChainDef def;
+    def.stiffness = 0.02f;
+    def.damping = 3.0f;
+    def.collision_mask = 0x2u;
+    def.friction = 0.5f;
+    const ViewDependentPhysicalObject chain = engine.createChain(def, level);
+    CHECK(chain.def().collision_mask == 0x2u && chain.def().friction == 0.5f);
+    const std::vector<float> zero_radii(8, 0.0f);
+    chain.setJointRadii(zero_radii);
+
+    const kodawari::Vec3 centre{0.2f, 0.82f, 0.0f};
+    ColliderDef ball_def = ColliderDef::sphere(0.1f, Transform{centre, kIdentity});
+    ball_def.layers = 0x2u;
+    const Collider ball = engine.createCollider(ball_def);
+    const Collider far = engine.createCollider(ColliderDef::capsule(0.05f, 0.1f, Transform{{5.0f, 0.0f, 0.0f}, kIdentity}));
+    CHECK(ball.isValid() && far.isValid() && ball != far && ball.engine() == engine.handle());
+    CHECK(engine.colliderCount() == 2 && engine.collider(ball.id()) == ball);
+    std::vector<kodawari::ColliderId> ids;
+    engine.colliderIds(ids);
+    CHECK(ids.size() == 2 && ids[0] == ball.id() && ids[1] == far.id());
+    std::array<kodawari::ColliderId, 4> id_buffer{};
+    CHECK(engine.colliderIds(id_buffer.data(), 4) == 2 && id_buffer[1] == far.id());
+
+    const Transform anchor{{0.0f, 1.0f, 0.0f}, kIdentity};
+    const kodawari::Vec3 camera{0.0f, 1.0f, 3.0f};
+    const std::array<Transform, 2> poses{Transform{centre, kIdentity}, Transform{{5.0f, 0.0f, 0.0f}, kIdentity}};
+    std::vector<Transform> world;
+    float closest = 1e30f;
+    for (int frame = 0; frame < 120; ++frame) {
+        engine.setColliderTransforms(poses);
+        engine.step(harness::kDt, camera, anchor);
+        chain.readWorld(world);
+        closest = 1e30f;
+        for (const Transform& joint : world) closest = std::fmin(closest, distance(joint.position, centre));
+        CHECK(closest >= 0.1f - 1e-4f);
+    }
+    CHECK(closest < 0.1f + 3.5e-3f);  // resting on the ball (segments collide too: joints up to 3.1 mm out)
+    CHECK(engine.stats().collider_count == 2 && engine.stats().contact_pairs_tested > 0);
+
+    const uint64_t before = engine.stateHash();
+    CHECK_THROWS(engine.setColliderTransforms(poses.data(), 1), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_THROWS(engine.setColliderTransforms(nullptr, 2), KDW_STATUS_NULL_POINTER);
+    std::array<Transform, 2> broken = poses;
+    broken[1].position.y = std::numeric_limits<float>::quiet_NaN();
+    CHECK_THROWS(engine.setColliderTransforms(broken), KDW_STATUS_INVALID_ARGUMENT);
+    broken[1] = Transform{{5.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 0.0f}};
+    CHECK_THROWS(engine.setColliderTransforms(broken), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_THROWS(engine.createCollider(ColliderDef::capsule(0.0f, 0.0f, anchor)), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_THROWS(engine.createCollider(ColliderDef::sphere(-1.0f, anchor)), KDW_STATUS_INVALID_ARGUMENT);
+    ColliderDef unknown_shape = ball_def;
+    unknown_shape.shape = 99;
+    CHECK_THROWS(engine.createCollider(unknown_shape), KDW_STATUS_INVALID_ARGUMENT);
+    ColliderDef wrong_size;
+    wrong_size.struct_size = 4;
+    CHECK_THROWS(engine.createCollider(wrong_size), KDW_STATUS_STRUCT_SIZE_MISMATCH);
+    CHECK_THROWS(chain.setJointRadii(zero_radii.data(), 7), KDW_STATUS_INVALID_ARGUMENT);
+    const std::vector<float> nan_radii(8, std::numeric_limits<float>::quiet_NaN());
+    CHECK_THROWS(chain.setJointRadii(nan_radii), KDW_STATUS_INVALID_ARGUMENT);
+    ChainDef bad_friction = chain.def();
+    bad_friction.friction = 11.0f;
+    CHECK_THROWS(chain.setDef(bad_friction), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK(engine.stateHash() == before && engine.colliderCount() == 2);
+
+    // Off the chain's layers, the ball no longer holds it.
+    ball.setLayers(0x4u);
+    float lowest = 1e30f;
+    for (int frame = 0; frame < 60; ++frame) {
+        engine.step(harness::kDt, camera, anchor);
+        chain.readWorld(world);
+        for (const Transform& joint : world) lowest = std::fmin(lowest, distance(joint.position, centre));
+    }
+    CHECK(lowest < 0.1f - 0.02f);
+
+    far.destroy();
+    CHECK(!far.isValid() && engine.colliderCount() == 1);
+    CHECK_THROWS(far.setLayers(1u), KDW_STATUS_INVALID_ID);
+    CHECK_THROWS(engine.destroyCollider(far), KDW_STATUS_INVALID_ID);
+    CHECK_THROWS(engine.collider(chain.id()).destroy(), KDW_STATUS_INVALID_ID);  // a chain id is no collider id
+    CHECK_THROWS(engine.chain(ball.id()).teleport(), KDW_STATUS_INVALID_ID);     // and vice versa
+    CHECK(!Collider().isValid());
+    Engine stranger{EngineDef()};
+    CHECK(!stranger.collider(ball.id()).isValid());
+    CHECK_THROWS(stranger.destroyCollider(ball), KDW_STATUS_INVALID_ID);
+    engine.destroyCollider(ball);
+    CHECK(engine.colliderCount() == 0 && !ball.isValid());
+    engine.setColliderTransforms(nullptr, 0);  // zero colliders, zero poses
+    chain.setJointRadii({});                   // back to the def's radius
+}
+
+// Teleports and scale through the RAII layer: in KDW_TELEPORT_RESET mode Engine::teleport and
+// ViewDependentPhysicalObject::teleport do exactly what reset does at the same step (equal state hashes); in
+// carry mode a 100 m jump with Engine::teleport keeps every chain's energy; scale is validated.
+void test_teleports_and_scale() {
+    const harness::Scene scene = harness::ahoge_scene();
+    EngineDef reset_mode;
+    reset_mode.teleport_mode = KDW_TELEPORT_RESET;
+    reset_mode.teleport_distance = std::numeric_limits<float>::max();  // only explicit teleports
+    Engine teleported{reset_mode}, reset{reset_mode};
+    const ViewDependentPhysicalObject a = teleported.createChain(ChainDef(), scene.base);
+    const ViewDependentPhysicalObject b = reset.createChain(ChainDef(), scene.base);
+    EngineDef carry_mode;
+    carry_mode.teleport_distance = std::numeric_limits<float>::max();
+    Engine jumper{carry_mode}, still{carry_mode};
+    const ViewDependentPhysicalObject carried = jumper.createChain(ChainDef(), scene.base);
+    const ViewDependentPhysicalObject reference = still.createChain(ChainDef(), scene.base);
+    CHECK(teleported.def().teleport_mode == KDW_TELEPORT_RESET);
+
+    for (int frame = 0; frame < 40; ++frame) {
+        const int swing = frame < 15 ? frame : 14;
+        Transform head{{0.1f * std::sin(0.4f * static_cast<float>(swing)), 1.6f, 0.0f}, kIdentity};
+        kodawari::Vec3 camera = harness::orbit_camera(0);
+        if (frame == 20) {
+            teleported.teleport();
+            reset.reset();
+            jumper.teleport();
+        }
+        if (frame == 30) {
+            a.teleport();
+            b.reset();
+        }
+        teleported.step(harness::kDt, camera, head);
+        reset.step(harness::kDt, camera, head);
+        still.step(harness::kDt, camera, head);
+        if (frame >= 20) {
+            head.position.x += 100.0f;
+            camera.x += 100.0f;
+        }
+        jumper.step(harness::kDt, camera, head);
+        CHECK(teleported.stateHash() == reset.stateHash());
+        if (frame >= 20) {
+            const float expected = reference.kineticEnergy();
+            CHECK(std::fabs(carried.kineticEnergy() - expected) <= 1e-3f * expected + 1e-7f);
+        }
+        if (frame == 20) CHECK(reference.kineticEnergy() > 1e-6f);  // still swinging: the comparison means something
+    }
+
+    EngineDef bad = carry_mode;
+    bad.scale = 0.0f;
+    CHECK_THROWS(jumper.setDef(bad), KDW_STATUS_INVALID_ARGUMENT);
+    bad.scale = std::numeric_limits<float>::quiet_NaN();
+    CHECK_THROWS(Engine{bad}, KDW_STATUS_INVALID_ARGUMENT);
+    bad.scale = 1e7f;
+    CHECK_THROWS(jumper.setDef(bad), KDW_STATUS_INVALID_ARGUMENT);
+    bad = carry_mode;
+    bad.teleport_mode = 2;
+    CHECK_THROWS(jumper.setDef(bad), KDW_STATUS_INVALID_ARGUMENT);
+    EngineDef large = carry_mode;
+    large.scale = 100.0f;
+    jumper.setDef(large);
+    CHECK(jumper.def().scale == 100.0f);
+}
+
 // Runs a test; an unexpected exception fails it.
 #define RUN(test)                                                                          \
     harness::run(#test, [] {                                                               \
@@ -473,6 +650,8 @@ int main() {
     RUN(test_orbit_scene_matches_plain_c);
     RUN(test_removed_and_destroyed_handles);
     RUN(test_shape_from_stroke);
+    RUN(test_colliders_and_joint_radii);
+    RUN(test_teleports_and_scale);
     run_no_exception_tests();
     std::printf("%d passed, %d failed\n", harness::counters().passed, harness::counters().failed);
     return harness::counters().failed == 0 ? 0 : 1;

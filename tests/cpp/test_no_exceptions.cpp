@@ -32,6 +32,10 @@ static_assert(std::is_same_v<decltype(Engine::create()), Result<Engine>>);
 static_assert(std::is_same_v<decltype(std::declval<Engine&>().chainCount()), Result<uint32_t>>);
 static_assert(std::is_same_v<decltype(std::declval<Engine&>().step(0.0f, {}, {})), Status>);
 static_assert(std::is_same_v<decltype(std::declval<ViewShape&>().remove()), Status>);
+static_assert(std::is_same_v<decltype(std::declval<Engine&>().createCollider(kodawari::ColliderDef())),
+                             Result<kodawari::Collider>>);
+static_assert(std::is_same_v<decltype(std::declval<Engine&>().setColliderTransforms(nullptr, 0)), Status>);
+static_assert(std::is_same_v<decltype(std::declval<Engine&>().teleport()), Status>);
 static_assert(std::is_same_v<kodawari::Ret<void>, Status>);
 static_assert(!std::is_constructible_v<Engine, const EngineDef&>, "no throwing constructor without exceptions");
 
@@ -97,6 +101,20 @@ void test_no_exceptions_scene() {
     CHECK_FAILS(ahoge.value().readWorld(joints), KDW_STATUS_INVALID_ID);
     CHECK(engine.chainCount().value() == 0 && engine.chainCount().valueOr(9) == 0);
     CHECK(Engine().jointCount().valueOr(9) == 9);
+
+    // Colliders, joint radii and teleports report failures the same way.
+    const Result<kodawari::Collider> ball = engine.createCollider(kodawari::ColliderDef());
+    CHECK(ball.ok() && ball.value().isValid() && engine.colliderCount().value() == 1);
+    const uint64_t with_ball = engine.stateHash().value();
+    CHECK_FAILS(engine.createCollider(kodawari::ColliderDef::sphere(-1.0f, scene.head)), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_FAILS(engine.setColliderTransforms(nullptr, 0), KDW_STATUS_INVALID_ARGUMENT);  // one pose per collider
+    CHECK_FAILS(engine.chain(ball.value().id()).teleport(), KDW_STATUS_INVALID_ID);
+    CHECK(engine.stateHash().value() == with_ball);
+    CHECK(engine.setColliderTransforms(&scene.head, 1).ok());
+    CHECK(engine.teleport().ok());
+    CHECK(ball.value().destroy().ok());
+    CHECK_FAILS(ball.value().setLayers(2u), KDW_STATUS_INVALID_ID);
+    CHECK(engine.colliderCount().valueOr(9) == 0);
 }
 
 }  // namespace

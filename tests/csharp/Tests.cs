@@ -30,6 +30,9 @@ static unsafe class Tests
         Run("shape_from_stroke_errors", SketchTests.ShapeFromStrokeErrors);
         Run("sketched_view_shape_drives_the_chain", SketchTests.SketchedViewShapeDrivesTheChain);
         Run("weights_follow_the_camera", SketchTests.WeightsFollowTheCamera);
+        Run("colliders_keep_the_chain_out", ColliderTests.CollidersKeepTheChainOut);
+        Run("collider_update_allocates_nothing", ColliderTests.ColliderUpdateAllocatesNothing);
+        Run("teleports_and_scale", ColliderTests.TeleportsAndScale);
         Run("readme_snippet", ReadmeSnippet.Run);
         Console.WriteLine(passed + " passed, " + failed + " failed");
         return failed;
@@ -113,8 +116,8 @@ static unsafe class Tests
         Ensure(sizeof(kdw_transform) == 28 && System.Runtime.InteropServices.Marshal.SizeOf(typeof(kdw_transform)) == 28,
                "kdw_transform is 28 bytes");
         Ensure(sizeof(JointTransform) == 28 && sizeof(Vec3) == 12 && sizeof(Quat) == 16, "public structs match");
-        Ensure(sizeof(kdw_engine_def) == 40 && sizeof(kdw_chain_def) == 32 && sizeof(kdw_engine_stats) == 56,
-               "def struct sizes match the C header");
+        Ensure(sizeof(kdw_engine_def) == 56 && sizeof(kdw_chain_def) == 40 && sizeof(kdw_engine_stats) == 64
+               && sizeof(kdw_collider_def) == 48, "def struct sizes match the C header");
         var mismatch = ExpectStatus(KodawariStatus.AbiMismatch, () => Library.CheckAbi(NativeMethods.KDW_ABI_VERSION + 1, NativeMethods.KDW_ABI_VERSION));
         Ensure(mismatch.Message.Contains("ABI"), "ABI mismatch message: " + mismatch.Message);
         ExpectStatus(KodawariStatus.AbiMismatch, () => Library.CheckSize("kdw_transform", 32, 32, 28));
@@ -161,6 +164,13 @@ static unsafe class Tests
         var chainDef = new ChainDef();
         Ensure(chainDef.Stiffness == chainNative.stiffness && chainDef.Damping == chainNative.damping
                && chainDef.Anchor == AnchorSource.ViewReference, "chain def defaults");
+        Ensure(chainDef.CollisionMask == chainNative.collision_mask && chainDef.Friction == chainNative.friction
+               && def.Scale == native.scale && def.TeleportMode == (TeleportMode)native.teleport_mode, "new def fields");
+        var colliderNative = NativeMethods.kdw_collider_def_default();
+        var colliderDef = new ColliderDef();
+        Ensure(colliderDef.Shape == ColliderShape.Sphere && colliderDef.Radius == colliderNative.radius
+               && colliderDef.Layers == colliderNative.layers && colliderDef.Transform.Rotation.W == colliderNative.transform.rotation.w
+               && colliderDef.Raw.struct_size == (uint)sizeof(kdw_collider_def), "collider def defaults");
         using (var engine = new Engine())
         {
             engine.Gravity = new Vec3(0f, -1.62f, 0f);

@@ -41,8 +41,29 @@ namespace UnityEngine
     public sealed class GameObject : Object
     {
         public Transform transform { get { throw null; } }
+        public int layer { get { throw null; } set { } }
         public T GetComponent<T>() { throw null; }
         public T AddComponent<T>() where T : Component { throw null; }
+    }
+
+    public class Collider : Component
+    {
+        public bool enabled { get { throw null; } set { } }
+        public bool isTrigger { get { throw null; } set { } }
+    }
+
+    public class SphereCollider : Collider
+    {
+        public Vector3 center { get { throw null; } set { } }
+        public float radius { get { throw null; } set { } }
+    }
+
+    public class CapsuleCollider : Collider
+    {
+        public Vector3 center { get { throw null; } set { } }
+        public float radius { get { throw null; } set { } }
+        public float height { get { throw null; } set { } }
+        public int direction { get { throw null; } set { } }
     }
 
     public class Transform : Component, IEnumerable

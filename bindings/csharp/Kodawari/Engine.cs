@@ -26,10 +26,10 @@ namespace Kodawari
         }
     }
 
-    /// <summary>One per character: owns chains (<see cref="ViewDependentPhysicalObject"/>) and their view shapes,
-    /// gravity and solver settings. One <see cref="Step(float, Vec3, JointTransform)"/> advances all chains.
-    /// Use from one thread at a time. The per-frame calls (SetAnchors, Step, ReadWorld, ReadLocalRotations)
-    /// allocate no managed memory.</summary>
+    /// <summary>One per character: owns chains (<see cref="ViewDependentPhysicalObject"/>), their view shapes,
+    /// colliders (<see cref="Collider"/>), gravity and solver settings. One <see cref="Step(float, Vec3, JointTransform)"/> advances all chains.
+    /// Use from one thread at a time. The per-frame calls (SetAnchors, SetColliderTransforms, Step, ReadWorld,
+    /// ReadLocalRotations) allocate no managed memory.</summary>
     public sealed unsafe class Engine : IDisposable
     {
         readonly EngineHandle owner;
@@ -150,6 +150,59 @@ namespace Kodawari
             return chains;
         }
 
+        // ---- colliders ----
+
+        /// <summary>Creates a collider (chains whose collision mask shares a bit with its layers are kept out of it, or
+        /// inside it). It comes last in the order of <see cref="SetColliderTransforms(ReadOnlySpan{JointTransform})"/>.</summary>
+        public Collider CreateCollider(ColliderDef def)
+        {
+            kdw_collider_def raw = def != null ? def.Raw : NativeMethods.kdw_collider_def_default();
+            ulong id = 0;
+            Library.Check(NativeMethods.kdw_collider_create(Ptr, &raw, &id));
+            return new Collider(this, id);
+        }
+
+        /// <summary>Number of colliders.</summary>
+        public int ColliderCount
+        {
+            get
+            {
+                uint count = 0;
+                Library.Check(NativeMethods.kdw_engine_collider_count(Ptr, &count));
+                return (int)count;
+            }
+        }
+
+        /// <summary>The colliders in creation order: the order of <see cref="SetColliderTransforms(ReadOnlySpan{JointTransform})"/>.
+        /// Allocates the array.</summary>
+        public Collider[] GetColliders()
+        {
+            int count = ColliderCount;
+            var ids = new ulong[Math.Max(count, 1)];
+            uint written = 0;
+            fixed (ulong* p = ids)
+                Library.Check(NativeMethods.kdw_engine_get_collider_ids(Ptr, p, (uint)ids.Length, &written));
+            var colliders = new Collider[written];
+            for (int i = 0; i < written; i++) colliders[i] = new Collider(this, ids[i]);
+            return colliders;
+        }
+
+        /// <summary>Every collider's world pose for the next step, in ONE native call: one entry per collider in creation
+        /// order (<see cref="GetColliders"/>). The step sweeps each collider from its last pose to this one.</summary>
+        public void SetColliderTransforms(ReadOnlySpan<JointTransform> poses)
+        {
+            fixed (JointTransform* p = &MemoryMarshal.GetReference(poses))
+                SetColliderTransforms(p, poses.Length);
+        }
+
+        /// <summary>Pointer form of <see cref="SetColliderTransforms(ReadOnlySpan{JointTransform})"/>.</summary>
+        public void SetColliderTransforms(JointTransform* poses, int count)
+        {
+            JointTransform none;
+            if (poses == null && count == 0) poses = &none;
+            Library.Check(NativeMethods.kdw_engine_set_collider_transforms(Ptr, (kdw_transform*)poses, Count(count)));
+        }
+
         // ---- per frame ----
 
         /// <summary>Sets every chain's anchor for the next step, world space: one entry per chain in creation order
@@ -243,6 +296,10 @@ namespace Kodawari
         /// <summary>Puts every chain back to its rest shape, at rest, at the next step (after a teleport, a cut).</summary>
         public void Reset() { Library.Check(NativeMethods.kdw_engine_reset(Ptr)); }
 
+        /// <summary>Every chain treats its anchor's motion in the next step as a teleport (<see cref="EngineDef.TeleportMode"/>),
+        /// however small: call it when the character is placed somewhere new.</summary>
+        public void Teleport() { Library.Check(NativeMethods.kdw_engine_teleport(Ptr)); }
+
         /// <summary>A hash of everything that determines future results (determinism checks).</summary>
         public ulong StateHash
         {
@@ -272,6 +329,8 @@ namespace Kodawari
                     SolverFallbacks = (long)raw.solver_fallbacks,
                     TimeDropped = raw.time_dropped,
                     SimulatedTime = raw.simulated_time,
+                    ColliderCount = (int)raw.collider_count,
+                    ContactPairsTested = (long)raw.contact_pairs_tested,
                 };
             }
         }

@@ -102,6 +102,31 @@ namespace Kodawari
         Own = NativeMethods.KDW_ANCHOR_OWN,
     }
 
+    /// <summary>What a teleport (an anchor jump beyond the engine's thresholds, or <see cref="Engine.Teleport"/>) does to
+    /// a chain.</summary>
+    public enum TeleportMode : uint
+    {
+        /// <summary>Moves the chain rigidly with its anchor, keeping its shape and adding no energy.</summary>
+        CarryShape = NativeMethods.KDW_TELEPORT_CARRY_SHAPE,
+        /// <summary>Puts the chain back to its rest shape under the new anchor, at rest.</summary>
+        Reset = NativeMethods.KDW_TELEPORT_RESET,
+    }
+
+    /// <summary>The shape of a <see cref="Collider"/> (<c>KDW_COLLIDER_*</c>).</summary>
+    public enum ColliderShape : uint
+    {
+        /// <summary>Keeps particles outside a ball of <see cref="ColliderDef.Radius"/>.</summary>
+        Sphere = NativeMethods.KDW_COLLIDER_SPHERE,
+        /// <summary>Keeps particles outside a capsule along the collider's local Y axis.</summary>
+        Capsule = NativeMethods.KDW_COLLIDER_CAPSULE,
+        /// <summary>Keeps particles on the local +Y side of the plane through the collider's origin.</summary>
+        Plane = NativeMethods.KDW_COLLIDER_PLANE,
+        /// <summary>Keeps particles inside a ball (radius &gt; 0).</summary>
+        InsideSphere = NativeMethods.KDW_COLLIDER_INSIDE_SPHERE,
+        /// <summary>Keeps particles inside a capsule (radius &gt; 0).</summary>
+        InsideCapsule = NativeMethods.KDW_COLLIDER_INSIDE_CAPSULE,
+    }
+
     /// <summary>Counters for profiling overlays (<c>kdw_engine_stats</c>).</summary>
     public struct EngineStats
     {
@@ -118,5 +143,8 @@ namespace Kodawari
         public double TimeDropped;
         /// <summary>Simulated seconds advanced in total.</summary>
         public double SimulatedTime;
+        public int ColliderCount;
+        /// <summary>(segment or particle, collider) pairs the contact pass tested in total.</summary>
+        public long ContactPairsTested;
     }
 }

@@ -87,6 +87,19 @@ namespace Kodawari
         /// <summary>Puts the chain back to its current rest shape, at rest, at the next step.</summary>
         public unsafe void Reset() { Library.Check(NativeMethods.kdw_chain_reset(Ptr, id)); }
 
+        /// <summary>Treats the anchor's motion in the next step as a teleport (the engine's
+        /// <see cref="EngineDef.TeleportMode"/>), however small.</summary>
+        public unsafe void Teleport() { Library.Check(NativeMethods.kdw_chain_teleport(Ptr, id)); }
+
+        /// <summary>Per-joint collision radii in character units (x the engine's scale m), each in [0, 1e6]: one per joint,
+        /// or none (an empty span) to go back to <see cref="ChainDef.Radius"/> for every joint.</summary>
+        public unsafe void SetJointRadii(ReadOnlySpan<float> radii)
+        {
+            float none;
+            fixed (float* p = &MemoryMarshal.GetReference(radii))
+                Library.Check(NativeMethods.kdw_chain_set_joint_radii(Ptr, id, p != null ? p : &none, Engine.Count(radii.Length)));
+        }
+
         /// <summary>This chain's world transforms (root to tip). Returns how many were written.</summary>
         public unsafe int ReadWorld(Span<JointTransform> output)
         {

@@ -5,9 +5,12 @@ using UnityEngine;
 namespace Kodawari.Unity
 {
     /// <summary>The kodawari engine of one character. Put it on the character's root: on enable it gathers the
-    /// <see cref="ViewDependentPhysicalObject"/>s below it and creates the native engine; every LateUpdate
-    /// (after animation) it pushes the chains' anchors, runs one native step with the camera and the view
-    /// reference bone, and writes every joint's localRotation. No managed allocation per frame.</summary>
+    /// <see cref="ViewDependentPhysicalObject"/>s below it, creates the native engine and the
+    /// <see cref="colliders"/>; at Start it can also pick up the Unity sphere and capsule colliders on the
+    /// character's bones (<see cref="autoCollectBoneColliders"/>). Every LateUpdate (after animation) it moves
+    /// every collider with its bone in one native call, pushes the chains' anchors, runs one native step with the
+    /// camera and the view reference bone, and writes every joint's localRotation. No managed allocation per
+    /// frame.</summary>
     [DisallowMultipleComponent]
     [DefaultExecutionOrder(10000)]
     [AddComponentMenu("Kodawari/Engine")]
@@ -38,6 +41,18 @@ namespace Kodawari.Unity
         [Tooltip("Most internal steps per frame; time beyond is dropped (a hitch does not explode).")]
         [Range(1, 1000)] public int maxSubsteps = 16;
 
+        [Tooltip("Size of the character relative to the units the chains' parameters are tuned in: multiplies gravity, "
+                 + "the teleport distance and the chains' radii (a character scaled by 100 with scale 100 moves like the original).")]
+        public float scale = 1f;
+
+        [Header("Colliders")]
+        [Tooltip("Colliders on the character's bones (head, shoulders, body) that keep the chains out.")]
+        public List<BoneCollider> colliders = new List<BoneCollider>();
+
+        [Tooltip("At Start, also create a collider for every enabled, non-trigger SphereCollider and CapsuleCollider "
+                 + "on this object and its children (the character's bones), on the layer bit of its Unity layer.")]
+        public bool autoCollectBoneColliders = false;
+
         [Header("Teleports")]
         [Tooltip("An anchor moving farther than this (m) in one frame is carried rigidly instead of whipping the chain.")]
         public float teleportDistance = 1f;
@@ -48,6 +63,10 @@ namespace Kodawari.Unity
         [Tooltip("Also reset the chains to their rest shapes when the character root jumps farther than the teleport distance in one frame.")]
         public bool resetOnTeleport = true;
 
+        [Tooltip("What a teleport does: carry the chains rigidly with their anchors (keeping their motion), or put "
+                 + "them back to their rest shapes.")]
+        public TeleportMode teleportMode = TeleportMode.CarryShape;
+
         Kodawari.Engine native;
         ViewDependentPhysicalObject[] active = new ViewDependentPhysicalObject[0];
         Kodawari.ViewDependentPhysicalObject[] chainHandles = new Kodawari.ViewDependentPhysicalObject[0];
@@ -56,6 +75,10 @@ namespace Kodawari.Unity
         Transform[] jointTransforms = new Transform[0];   // every joint, in the engine's batched order
         JointTransform[] anchors = new JointTransform[0];
         Quat[] localRotations = new Quat[0];
+        readonly List<BoneCollider> collectedColliders = new List<BoneCollider>(); // autoCollectBoneColliders, at Start
+        readonly List<BoneCollider> activeColliders = new List<BoneCollider>();    // native creation order
+        JointTransform[] colliderPoses = new JointTransform[0];                    // one per active collider, reused
+        bool started;
         bool settingsChanged;
         Vector3 lastRootPosition;
 
@@ -74,6 +97,51 @@ namespace Kodawari.Unity
                 Teardown();
                 enabled = false;
             }
+        }
+
+        void Start()
+        {
+            started = true;
+            if (!autoCollectBoneColliders) return;
+            CollectBoneColliders(collectedColliders);
+            if (native == null) return;
+            try
+            {
+                CreateColliders(collectedColliders);
+            }
+            catch (Exception e)
+            {
+                Debug.LogException(e, this);
+            }
+        }
+
+        /// <summary>Appends an entry for every enabled, non-trigger <c>SphereCollider</c> and <c>CapsuleCollider</c> on
+        /// this object and its active children (what <see cref="autoCollectBoneColliders"/> picks up at Start).</summary>
+        public void CollectBoneColliders(List<BoneCollider> into)
+        {
+            foreach (SphereCollider sphere in GetComponentsInChildren<SphereCollider>(false))
+                if (sphere.enabled && !sphere.isTrigger) into.Add(BoneCollider.From(sphere));
+            foreach (CapsuleCollider capsule in GetComponentsInChildren<CapsuleCollider>(false))
+                if (capsule.enabled && !capsule.isTrigger) into.Add(BoneCollider.From(capsule));
+        }
+
+        /// <summary>Number of colliders the native engine has (serialized and collected), 0 while not running.</summary>
+        public int ColliderCount { get { return native != null ? activeColliders.Count : 0; } }
+
+        void CreateColliders(List<BoneCollider> source)
+        {
+            if (source == null) return;
+            foreach (BoneCollider entry in source)
+            {
+                if (entry == null || entry.bone == null)
+                {
+                    Debug.LogWarning("Kodawari: a collider without a bone was skipped.", this);
+                    continue;
+                }
+                native.CreateCollider(entry.CreateDef());
+                activeColliders.Add(entry);
+            }
+            colliderPoses = new JointTransform[activeColliders.Count]; // setup only, reused every frame
         }
 
         void OnDisable() { Teardown(); }
@@ -95,6 +163,13 @@ namespace Kodawari.Unity
             if (native != null) native.Reset();
         }
 
+        /// <summary>The character was placed somewhere new: the next frame treats every chain's anchor motion as a
+        /// teleport (<see cref="teleportMode"/>), however small.</summary>
+        public void Teleport()
+        {
+            if (native != null) native.Teleport();
+        }
+
         EngineDef CreateDef()
         {
             return new EngineDef
@@ -106,6 +181,8 @@ namespace Kodawari.Unity
                 MaxSubsteps = maxSubsteps,
                 TeleportDistance = Mathf.Max(teleportDistance, 1e-4f),
                 TeleportAngle = Mathf.Max(teleportAngle, 0.01f) * Mathf.Deg2Rad,
+                TeleportMode = teleportMode,
+                Scale = Mathf.Clamp(scale, 1e-6f, 1e6f),
             };
         }
 
@@ -169,6 +246,9 @@ namespace Kodawari.Unity
             jointTransforms = jointList.ToArray();
             anchors = new JointTransform[anchorTransforms.Length];
             localRotations = new Quat[jointTransforms.Length];
+            activeColliders.Clear();
+            CreateColliders(colliders);
+            if (started) CreateColliders(collectedColliders);
             settingsChanged = false;
             lastRootPosition = transform.position;
             if (reference == null) Debug.LogWarning("Kodawari: no view reference bone", this);
@@ -178,6 +258,7 @@ namespace Kodawari.Unity
         {
             if (native != null) native.Dispose();
             native = null;
+            activeColliders.Clear();
         }
 
         bool AnyChainChanged()
@@ -196,6 +277,13 @@ namespace Kodawari.Unity
 
             // Anchors: each chain root's parent.
             for (int i = 0; i < anchorTransforms.Length; i++) anchors[i] = anchorTransforms[i].WorldPose();
+
+            // Colliders follow their bones: every pose in one native call, from the preallocated array.
+            if (colliderPoses.Length > 0)
+            {
+                for (int i = 0; i < colliderPoses.Length; i++) colliderPoses[i] = activeColliders[i].WorldPose();
+                native.SetColliderTransforms(colliderPoses);
+            }
 
             if (resetOnTeleport && (transform.position - lastRootPosition).sqrMagnitude > teleportDistance * teleportDistance)
                 native.Reset();

@@ -55,6 +55,13 @@ namespace Kodawari.Unity
         [Tooltip("Multiplier on the engine's gravity.")]
         [Range(-10f, 10f)] public float gravityScale = 1f;
 
+        [Header("Collisions")]
+        [Tooltip("Collider layer bits this chain collides with (-1: all; 0: none, and no collision cost).")]
+        public int collisionMask = -1;
+
+        [Tooltip("Coulomb friction against colliders: 0 slides freely, 1 and more sticks.")]
+        [Range(0f, 10f)] public float friction = 0.3f;
+
         [Header("View shapes")]
         public List<ViewShapeData> viewShapes = new List<ViewShapeData>();
 
@@ -98,6 +105,8 @@ namespace Kodawari.Unity
                 Radius = radius,
                 GravityScale = gravityScale,
                 Anchor = AnchorSource.Own,
+                CollisionMask = unchecked((uint)collisionMask),
+                Friction = friction,
             };
         }
 
@@ -309,6 +318,7 @@ namespace Kodawari.Unity
         {
             mass = Mathf.Max(mass, 1e-4f);
             radius = Mathf.Max(radius, 0f);
+            friction = Mathf.Clamp(friction, 0f, 10f);
             parametersChanged = true;
         }
     }

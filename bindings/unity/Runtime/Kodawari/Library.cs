@@ -52,6 +52,7 @@ namespace Kodawari
             CheckSize("JointTransform", sizeof(JointTransform), Marshal.SizeOf(typeof(JointTransform)), 28);
             CheckSize("Vec2", sizeof(Vec2), Marshal.SizeOf(typeof(Vec2)), 8);
             CheckSize("kdw_stroke_camera", sizeof(kdw_stroke_camera), Marshal.SizeOf(typeof(kdw_stroke_camera)), 56);
+            CheckSize("kdw_collider_def", sizeof(kdw_collider_def), Marshal.SizeOf(typeof(kdw_collider_def)), 48);
         }
 
         internal static void CheckSize(string name, int unmanaged, int marshalled, int expected)

@@ -131,11 +131,12 @@ typedef struct kdw_collider_def {
     uint32_t shape;
     // Sphere and capsule radius, m (world units), in [0, 1e6]; > 0 for inside colliders. Default 0.1.
     float radius;
-    // Capsule half length of the axis, m, in [0, 1e6]. Default 0.
+    // Capsule half length of the axis, m, in [0, 1e6]. Default 0. Fields a shape does not use are ignored
+    // but must still be finite and in range.
     float half_height;
     // Initial world pose; `kdw_engine_set_collider_transforms` moves it every frame.
     struct kdw_transform transform;
-    // Layers the collider is on: it affects chains whose `collision_mask` shares a bit. Default 1.
+    // Layers the collider is on: it affects chains whose `collision_mask` shares a bit (0: none). Default 1.
     uint32_t layers;
 } kdw_collider_def;
 
@@ -271,8 +272,9 @@ extern "C" {
 // Steps `count` distinct engines by `dt` with one camera, engine i with its view reference
 // `view_references[i]` (as `kdw_engine_step` each). Built with the `parallel` feature, the engines are
 // stepped on a small thread pool; otherwise one after the other (the Unity package ships without it:
-// Unity hosts step from their own jobs). Every handle and input is checked before any engine moves: a NULL,
-// poisoned or repeated handle, or any bad input, fails the whole call and changes nothing. A panic while
+// Unity hosts step from their own jobs). Every handle and input is checked before any engine moves: a NULL
+// (`KDW_STATUS_NULL_POINTER`), poisoned (`KDW_STATUS_PANIC`) or repeated (`KDW_STATUS_INVALID_ARGUMENT`)
+// handle, or any bad input, fails the whole call and changes nothing. A panic while
 // stepping poisons every engine of the call.
 kdw_status kdw_engines_step(struct kdw_engine *const *engines,
                             uint32_t count,
@@ -339,7 +341,8 @@ kdw_status kdw_chain_read_rest_shape(const struct kdw_engine *engine,
 kdw_status kdw_chain_kinetic_energy(const struct kdw_engine *engine, kdw_chain_id chain, float *out_energy);
 
 // Per-joint collision radii in character units (× the engine's `scale` m), each in [0, 1e6]: `count` must
-// equal the chain's joint count, or be 0 to go back to the chain def's `radius` for every joint.
+// equal the chain's joint count, or be 0 to go back to the chain def's `radius` for every joint. Wakes the
+// chain if it was asleep.
 kdw_status kdw_chain_set_joint_radii(struct kdw_engine *engine,
                                      kdw_chain_id chain,
                                      const float *radii,
@@ -376,11 +379,18 @@ kdw_status kdw_collider_is_valid(const struct kdw_engine *engine,
                                  kdw_collider_id collider,
                                  uint32_t *out_valid);
 
+// Resizes a collider (its shape kind stays): `radius` and `half_height` as in `kdw_collider_def`, validated
+// the same way. For a collider following a bone whose scale changes.
+kdw_status kdw_collider_set_size(struct kdw_engine *engine,
+                                 kdw_collider_id collider,
+                                 float radius,
+                                 float half_height);
+
 // Moves a collider to other layers.
 kdw_status kdw_collider_set_layers(struct kdw_engine *engine, kdw_collider_id collider, uint32_t layers);
 
-// Sets every collider's world pose for the next step: `count` must equal the collider count, entry i
-// belongs to the i-th collider in creation order. The step sweeps each collider from its last pose to
+// Sets every collider's world pose for the next step: `count` must equal the collider count (`transforms`
+// may be NULL only when it is 0), entry i belongs to the i-th collider in creation order. The step sweeps each collider from its last pose to
 // this one across its substeps (a jump beyond the teleport thresholds is not swept).
 kdw_status kdw_engine_set_collider_transforms(struct kdw_engine *engine,
                                               const struct kdw_transform *transforms,

@@ -1777,7 +1777,7 @@ fn collider_def_variants() -> Vec<(String, kdw_collider_def, kdw_status)> {
     }
     let null_rotation = kdw_quat { x: 0.0, y: 0.0, z: 0.0, w: 0.0 };
     let far = kdw_transform { position: vec3(0.0, 1e30, 0.0), ..head() };
-    let ranged: [(&str, kdw_collider_def); 18] = [
+    let ranged: [(&str, kdw_collider_def); 21] = [
         ("range", kdw_collider_def { radius: -0.01, ..sphere }),
         ("range", kdw_collider_def { radius: -0.01, ..capsule }),
         ("range", kdw_collider_def { half_height: -0.01, ..capsule }),
@@ -1808,6 +1808,10 @@ fn collider_def_variants() -> Vec<(String, kdw_collider_def, kdw_status)> {
                 ..collider_def(KDW_COLLIDER_PLANE, 0.0, 0.0)
             },
         ),
+        // Fields a shape does not use are ignored, but must still be valid.
+        ("unused", collider_def(KDW_COLLIDER_SPHERE, 0.1, f32::NAN)),
+        ("unused", collider_def(KDW_COLLIDER_INSIDE_SPHERE, 0.1, -1.0)),
+        ("unused", collider_def(KDW_COLLIDER_PLANE, f32::INFINITY, 0.0)),
     ];
     for (tag, def) in ranged {
         out.push((format!("{tag}:{{}}"), def, KDW_STATUS_INVALID_ARGUMENT));
@@ -1874,8 +1878,35 @@ fn collider_and_teleport_cases(fx: &Fixture, c: &mut Vec<Case>) {
         nullp,
         Box::new(|fx| (kdw_collider_set_layers(null_mut(), fx.collider, 2), true)),
     ));
+    c.push(case(
+        "kdw_collider_set_size",
+        "null:engine",
+        nullp,
+        Box::new(|fx| (kdw_collider_set_size(null_mut(), fx.collider, 0.1, 0.0), true)),
+    ));
+    for (tag, v) in BAD_FLOATS.into_iter().chain([("range", -0.1), ("huge", 1e30)]) {
+        c.push(case(
+            "kdw_collider_set_size",
+            format!("{tag}:radius"),
+            badarg,
+            Box::new(move |fx| (kdw_collider_set_size(fx.a, fx.collider, v, 0.0), true)),
+        ));
+        // The fixture's first collider is a sphere: its half height is unused but still checked.
+        c.push(case(
+            "kdw_collider_set_size",
+            format!("{tag}:half_height"),
+            badarg,
+            Box::new(move |fx| (kdw_collider_set_size(fx.a, fx.collider, 0.1, v), true)),
+        ));
+    }
     for (tag, id) in fx.bad_collider_ids() {
         let t = format!("{tag}:collider");
+        c.push(case(
+            "kdw_collider_set_size",
+            t.clone(),
+            badid,
+            Box::new(move |fx| (kdw_collider_set_size(fx.a, id, 0.1, 0.0), true)),
+        ));
         c.push(case(
             "kdw_collider_destroy",
             t.clone(),

@@ -38,6 +38,21 @@ impl ColliderShape {
         }
     }
 
+    /// The same kind of shape with another size, validated; unused sizes must still be valid lengths.
+    pub fn resized(&self, radius: f32, half_height: f32) -> Result<Self> {
+        check_length("radius", radius, 0.0)?;
+        check_length("half_height", half_height, 0.0)?;
+        let shape = match self {
+            Self::Sphere { .. } => Self::Sphere { radius },
+            Self::Capsule { .. } => Self::Capsule { radius, half_height },
+            Self::Plane => Self::Plane,
+            Self::InsideSphere { .. } => Self::InsideSphere { radius },
+            Self::InsideCapsule { .. } => Self::InsideCapsule { radius, half_height },
+        };
+        ColliderDef { shape, ..Default::default() }.validate()?;
+        Ok(shape)
+    }
+
     pub fn keeps_inside(&self) -> bool {
         matches!(self, Self::InsideSphere { .. } | Self::InsideCapsule { .. })
     }
@@ -68,15 +83,17 @@ impl Default for ColliderDef {
     }
 }
 
+fn check_length(name: &str, value: f32, min: f32) -> Result<()> {
+    if value.is_finite() && value >= min && value <= MAX_RADIUS {
+        Ok(())
+    } else {
+        Err(Error::invalid_argument(format!("collider {name} {value} outside [{min}, {MAX_RADIUS}] m")))
+    }
+}
+
 impl ColliderDef {
     pub fn validate(&self) -> Result<()> {
-        let length = |name: &str, value: f32, min: f32| -> Result<()> {
-            if value.is_finite() && value >= min && value <= MAX_RADIUS {
-                Ok(())
-            } else {
-                Err(Error::invalid_argument(format!("collider {name} {value} outside [{min}, {MAX_RADIUS}] m")))
-            }
-        };
+        let length = check_length;
         match self.shape {
             ColliderShape::Sphere { radius } | ColliderShape::InsideSphere { radius } => {
                 length("radius", radius, 0.0)?;

@@ -345,6 +345,16 @@ impl Engine {
             .map(|&slot| Id::from_bits(self.colliders.id_at(slot as usize).expect("live").to_bits()))
     }
 
+    /// Changes a collider's size (its kind stays): `radius` and `half_height` as in [`ColliderShape`], both
+    /// validated like at creation; a field the shape does not use must still be finite and in range.
+    pub fn set_collider_size(&mut self, id: ColliderId, radius: f32, half_height: f32) -> Result<()> {
+        let collider = self.colliders.get(Id::from_bits(id.to_bits())).ok_or_else(|| collider_not_found(id))?;
+        let shape = collider.shape.resized(radius, half_height)?;
+        self.colliders.get_mut(Id::from_bits(id.to_bits())).expect("checked above").shape = shape;
+        self.wake_all();
+        Ok(())
+    }
+
     /// Changes a collider's layers.
     pub fn set_collider_layers(&mut self, id: ColliderId, layers: u32) -> Result<()> {
         self.colliders.get_mut(Id::from_bits(id.to_bits())).ok_or_else(|| collider_not_found(id))?.layers = layers;

@@ -11,8 +11,9 @@ use crate::core::{Engine, Transform, step_engines};
 /// Steps `count` distinct engines by `dt` with one camera, engine i with its view reference
 /// `view_references[i]` (as `kdw_engine_step` each). Built with the `parallel` feature, the engines are
 /// stepped on a small thread pool; otherwise one after the other (the Unity package ships without it:
-/// Unity hosts step from their own jobs). Every handle and input is checked before any engine moves: a NULL,
-/// poisoned or repeated handle, or any bad input, fails the whole call and changes nothing. A panic while
+/// Unity hosts step from their own jobs). Every handle and input is checked before any engine moves: a NULL
+/// (`KDW_STATUS_NULL_POINTER`), poisoned (`KDW_STATUS_PANIC`) or repeated (`KDW_STATUS_INVALID_ARGUMENT`)
+/// handle, or any bad input, fails the whole call and changes nothing. A panic while
 /// stepping poisons every engine of the call.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engines_step(

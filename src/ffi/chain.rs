@@ -164,7 +164,8 @@ pub extern "C" fn kdw_chain_kinetic_energy(
 }
 
 /// Per-joint collision radii in character units (× the engine's `scale` m), each in [0, 1e6]: `count` must
-/// equal the chain's joint count, or be 0 to go back to the chain def's `radius` for every joint.
+/// equal the chain's joint count, or be 0 to go back to the chain def's `radius` for every joint. Wakes the
+/// chain if it was asleep.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_chain_set_joint_radii(
     engine: *mut kdw_engine,

@@ -51,6 +51,21 @@ pub extern "C" fn kdw_collider_is_valid(
     query(engine, out_valid, "out_valid", |e| Ok(e.is_collider_valid(ColliderId::from_bits(collider)) as u32))
 }
 
+/// Resizes a collider (its shape kind stays): `radius` and `half_height` as in `kdw_collider_def`, validated
+/// the same way. For a collider following a bone whose scale changes.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_collider_set_size(
+    engine: *mut kdw_engine,
+    collider: kdw_collider_id,
+    radius: f32,
+    half_height: f32,
+) -> kdw_status {
+    // SAFETY: live engine handle, this thread only.
+    guard(|| unsafe {
+        with_engine_mut(engine, |e| Ok(e.set_collider_size(ColliderId::from_bits(collider), radius, half_height)?))
+    })
+}
+
 /// Moves a collider to other layers.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_collider_set_layers(
@@ -64,8 +79,8 @@ pub extern "C" fn kdw_collider_set_layers(
     })
 }
 
-/// Sets every collider's world pose for the next step: `count` must equal the collider count, entry i
-/// belongs to the i-th collider in creation order. The step sweeps each collider from its last pose to
+/// Sets every collider's world pose for the next step: `count` must equal the collider count (`transforms`
+/// may be NULL only when it is 0), entry i belongs to the i-th collider in creation order. The step sweeps each collider from its last pose to
 /// this one across its substeps (a jump beyond the teleport thresholds is not swept).
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engine_set_collider_transforms(

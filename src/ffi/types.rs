@@ -170,11 +170,12 @@ pub struct kdw_collider_def {
     pub shape: u32,
     /// Sphere and capsule radius, m (world units), in [0, 1e6]; > 0 for inside colliders. Default 0.1.
     pub radius: f32,
-    /// Capsule half length of the axis, m, in [0, 1e6]. Default 0.
+    /// Capsule half length of the axis, m, in [0, 1e6]. Default 0. Fields a shape does not use are ignored
+    /// but must still be finite and in range.
     pub half_height: f32,
     /// Initial world pose; `kdw_engine_set_collider_transforms` moves it every frame.
     pub transform: kdw_transform,
-    /// Layers the collider is on: it affects chains whose `collision_mask` shares a bit. Default 1.
+    /// Layers the collider is on: it affects chains whose `collision_mask` shares a bit (0: none). Default 1.
     pub layers: u32,
 }
 
@@ -202,6 +203,13 @@ impl TryFrom<&kdw_collider_def> for ColliderDef {
     type Error = crate::core::Error;
     fn try_from(d: &kdw_collider_def) -> Result<Self, Self::Error> {
         let (radius, half_height) = (d.radius, d.half_height);
+        // Fields a shape does not use are ignored, but a NaN or negative one is still a caller's mistake.
+        for (name, value) in [("radius", radius), ("half_height", half_height)] {
+            if !(value.is_finite() && (0.0..=crate::core::params::MAX_RADIUS).contains(&value)) {
+                let message = format!("collider {name} {value} must be finite and in [0, 1e6] (even where unused)");
+                return Err(crate::core::Error::invalid_argument(message));
+            }
+        }
         let shape = match d.shape {
             KDW_COLLIDER_SPHERE => ColliderShape::Sphere { radius },
             KDW_COLLIDER_CAPSULE => ColliderShape::Capsule { radius, half_height },

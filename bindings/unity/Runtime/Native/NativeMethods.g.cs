@@ -29,8 +29,9 @@ namespace Kodawari.Native
         ///  Steps `count` distinct engines by `dt` with one camera, engine i with its view reference
         ///  `view_references[i]` (as `kdw_engine_step` each). Built with the `parallel` feature, the engines are
         ///  stepped on a small thread pool; otherwise one after the other (the Unity package ships without it:
-        ///  Unity hosts step from their own jobs). Every handle and input is checked before any engine moves: a NULL,
-        ///  poisoned or repeated handle, or any bad input, fails the whole call and changes nothing. A panic while
+        ///  Unity hosts step from their own jobs). Every handle and input is checked before any engine moves: a NULL
+        ///  (`KDW_STATUS_NULL_POINTER`), poisoned (`KDW_STATUS_PANIC`) or repeated (`KDW_STATUS_INVALID_ARGUMENT`)
+        ///  handle, or any bad input, fails the whole call and changes nothing. A panic while
         ///  stepping poisons every engine of the call.
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_engines_step", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
@@ -115,7 +116,8 @@ namespace Kodawari.Native
 
         /// <summary>
         ///  Per-joint collision radii in character units (× the engine's `scale` m), each in [0, 1e6]: `count` must
-        ///  equal the chain's joint count, or be 0 to go back to the chain def's `radius` for every joint.
+        ///  equal the chain's joint count, or be 0 to go back to the chain def's `radius` for every joint. Wakes the
+        ///  chain if it was asleep.
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_chain_set_joint_radii", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
         internal static extern int kdw_chain_set_joint_radii(kdw_engine* engine, ulong chain, float* radii, uint count);
@@ -172,14 +174,21 @@ namespace Kodawari.Native
         internal static extern int kdw_collider_is_valid(kdw_engine* engine, ulong collider, uint* out_valid);
 
         /// <summary>
+        ///  Resizes a collider (its shape kind stays): `radius` and `half_height` as in `kdw_collider_def`, validated
+        ///  the same way. For a collider following a bone whose scale changes.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_collider_set_size", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_collider_set_size(kdw_engine* engine, ulong collider, float radius, float half_height);
+
+        /// <summary>
         ///  Moves a collider to other layers.
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_collider_set_layers", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
         internal static extern int kdw_collider_set_layers(kdw_engine* engine, ulong collider, uint layers);
 
         /// <summary>
-        ///  Sets every collider's world pose for the next step: `count` must equal the collider count, entry i
-        ///  belongs to the i-th collider in creation order. The step sweeps each collider from its last pose to
+        ///  Sets every collider's world pose for the next step: `count` must equal the collider count (`transforms`
+        ///  may be NULL only when it is 0), entry i belongs to the i-th collider in creation order. The step sweeps each collider from its last pose to
         ///  this one across its substeps (a jump beyond the teleport thresholds is not swept).
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_engine_set_collider_transforms", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
@@ -724,7 +733,8 @@ namespace Kodawari.Native
         /// </summary>
         public float radius;
         /// <summary>
-        ///  Capsule half length of the axis, m, in [0, 1e6]. Default 0.
+        ///  Capsule half length of the axis, m, in [0, 1e6]. Default 0. Fields a shape does not use are ignored
+        ///  but must still be finite and in range.
         /// </summary>
         public float half_height;
         /// <summary>
@@ -732,7 +742,7 @@ namespace Kodawari.Native
         /// </summary>
         public kdw_transform transform;
         /// <summary>
-        ///  Layers the collider is on: it affects chains whose `collision_mask` shares a bit. Default 1.
+        ///  Layers the collider is on: it affects chains whose `collision_mask` shares a bit (0: none). Default 1.
         /// </summary>
         public uint layers;
     }

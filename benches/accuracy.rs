@@ -283,7 +283,9 @@ fn pendulum_run(reference: &PendulumReference, fps: u32, settings: EngineSetting
         let t = k as f64 / fps as f64;
         let out = world(&engine, id);
         worst_stretch = worst_stretch.max(stretch(&out, &lengths));
-        let (represented, now) = (reference.at(t - h), reference.at(t));
+        // Before the first internal step (a level of detail's internal rate below the frame rate) the output
+        // is the initial state.
+        let (represented, now) = (reference.at((t - h).max(0.0)), reference.at(t));
         for j in 1..out.len() {
             let e = (out[j] - represented[j]).length_squared();
             physics += e;

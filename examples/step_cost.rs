@@ -1,6 +1,15 @@
 //! Cost of `Engine::step` per joint per internal substep, for a few scene sizes (scalar path, default
 //! settings, camera orbiting). A quick baseline until the criterion benchmarks of the performance work land:
 //! `cargo run --release --example step_cost`. Prints medians over repeated runs (the machine is shared).
+//!
+//! Two motions: a still head, where the upright chains only settle under gravity along their own axis (the
+//! cheapest case: nothing bends or turns), and a head swaying 0.2 m at 1 Hz, where every chain bends and
+//! every solver iteration does real work.
+//!
+//! `cargo run --release --example step_cost -- CHAINS JOINTS FRAMES [still|sway]` runs one scene once for
+//! a fixed workload (after one warm-up frame), for instruction counts, e.g.
+//! `valgrind --tool=callgrind target/release/examples/step_cost 10 16 50 sway`; divide `Engine::step`'s
+//! inclusive count by `CHAINS * (JOINTS - 1)` and by the substeps of all frames, warm-up included (printed).
 
 use std::time::Instant;
 
@@ -17,30 +26,63 @@ fn scene(chains: usize, joints: usize) -> Engine {
     engine
 }
 
+/// Steps frames `frames` at 60 fps with the camera orbiting the head (and the head swaying if `sway`).
+fn run(engine: &mut Engine, frames: std::ops::Range<usize>, sway: bool) {
+    for frame in frames {
+        let t = frame as f32 / 60.0;
+        let offset = if sway { 0.2 * (std::f32::consts::TAU * t).sin() } else { 0.0 };
+        let head = Transform::new(Vec3::new(offset, 1.6, 0.0), Quat::IDENTITY);
+        let angle = frame as f32 * 0.01;
+        let camera = Vec3::new(0.0, 1.6, 0.0) + Vec3::new(3.0 * angle.cos(), 0.1, 3.0 * angle.sin());
+        engine.step(1.0 / 60.0, camera, head).expect("valid step");
+    }
+}
+
+/// Median seconds per frame over 7 rounds.
+fn time_per_frame(chains: usize, joints: usize, sway: bool) -> (f64, f64) {
+    let mut engine = scene(chains, joints);
+    let frames = (2_000_000 / (chains * joints)).clamp(60, 2000);
+    let mut per_frame = Vec::new();
+    for round in 0..7 {
+        let start = Instant::now();
+        run(&mut engine, round * frames..(round + 1) * frames, sway);
+        per_frame.push(start.elapsed().as_secs_f64() / frames as f64);
+    }
+    per_frame.sort_by(f64::total_cmp);
+    (per_frame[per_frame.len() / 2], engine.stats().substeps_last_step as f64)
+}
+
 fn main() {
-    let head = Transform::new(Vec3::new(0.0, 1.6, 0.0), Quat::IDENTITY);
-    println!("{:>10} {:>8} {:>14} {:>16}", "chains", "joints", "us per frame", "ns/joint/substep");
-    for (chains, joints) in [(1usize, 8usize), (100, 8), (100, 16), (1000, 16), (1, 256)] {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.len() >= 3 {
+        let number = |i: usize| args[i].parse::<usize>().expect("usage: step_cost CHAINS JOINTS FRAMES [still|sway]");
+        let (chains, joints, frames) = (number(0), number(1), number(2));
+        let sway = args.get(3).is_some_and(|m| m == "sway");
         let mut engine = scene(chains, joints);
-        let frames = (2_000_000 / (chains * joints)).clamp(60, 2000);
-        let mut per_frame = Vec::new();
-        for round in 0..7 {
-            let start = Instant::now();
-            for frame in 0..frames {
-                let angle = (round * frames + frame) as f32 * 0.01;
-                let camera = head.position + Vec3::new(3.0 * angle.cos(), 0.1, 3.0 * angle.sin());
-                engine.step(1.0 / 60.0, camera, head).expect("valid step");
-            }
-            per_frame.push(start.elapsed().as_secs_f64() / frames as f64);
-        }
-        per_frame.sort_by(f64::total_cmp);
-        let median = per_frame[per_frame.len() / 2];
-        let substeps = engine.stats().substeps_last_step as f64;
-        let dynamic_joints = (chains * (joints - 1)) as f64;
+        let start = Instant::now();
+        run(&mut engine, 0..frames + 1, sway);
+        let elapsed = start.elapsed().as_secs_f64();
+        let substeps = engine.stats().substeps_total;
         println!(
-            "{chains:>10} {joints:>8} {:>14.1} {:>16.0}",
-            median * 1e6,
-            median * 1e9 / (dynamic_joints * substeps)
+            "{chains} chains x {joints} joints, {} frames ({}), {substeps} substeps: {:.0} ns/joint/substep",
+            frames + 1,
+            if sway { "sway" } else { "still" },
+            elapsed * 1e9 / ((chains * (joints - 1)) as f64 * substeps as f64),
         );
+        return;
+    }
+    println!("{:>8} {:>7} {:>15} {:>15} {:>15} {:>15}", "", "", "still head", "", "swaying head", "");
+    println!(
+        "{:>8} {:>7} {:>15} {:>15} {:>15} {:>15}",
+        "chains", "joints", "us per frame", "ns/joint/subst", "us per frame", "ns/joint/subst"
+    );
+    for (chains, joints) in [(1usize, 8usize), (100, 8), (100, 16), (1000, 16), (1, 256)] {
+        let dynamic_joints = (chains * (joints - 1)) as f64;
+        print!("{chains:>8} {joints:>7}");
+        for sway in [false, true] {
+            let (median, substeps) = time_per_frame(chains, joints, sway);
+            print!(" {:>15.1} {:>15.0}", median * 1e6, median * 1e9 / (dynamic_joints * substeps));
+        }
+        println!();
     }
 }

@@ -21,23 +21,13 @@ pub struct ConstraintScratch {
     directions: Vec<DVec3>,
     residual: Vec<f64>,
     diag: Vec<f64>,
-    lower: Vec<f64>,
-    upper: Vec<f64>,
     c_prime: Vec<f64>,
     d_prime: Vec<f64>,
 }
 
 impl ConstraintScratch {
     pub fn reserve(&mut self, bonds: usize) {
-        for v in [
-            &mut self.lambda,
-            &mut self.residual,
-            &mut self.diag,
-            &mut self.lower,
-            &mut self.upper,
-            &mut self.c_prime,
-            &mut self.d_prime,
-        ] {
+        for v in [&mut self.lambda, &mut self.residual, &mut self.diag, &mut self.c_prime, &mut self.d_prime] {
             if v.len() < bonds {
                 v.resize(bonds, 0.0);
             }
@@ -83,27 +73,33 @@ pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f3
 /// to `p` and returns `true` when converged, leaves `p` untouched otherwise.
 fn newton_along_directions(p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f64, s: &mut ConstraintScratch) -> bool {
     let m = lengths.len();
+    let p = &mut p[..m + 1];
     let w = |j: usize| inv_mass(j, dynamic_inv_mass);
-    s.lambda[..m].fill(0.0);
+    let d = &s.directions[..m];
+    let (lambda, bonds, residual) = (&mut s.lambda[..m], &mut s.bonds[..m], &mut s.residual[..m]);
+    let (diag, c_prime, d_prime) = (&mut s.diag[..m], &mut s.c_prime[..m], &mut s.d_prime[..m]);
+    lambda.fill(0.0);
     let mut converged = false;
     let mut previous_worst = f64::INFINITY;
     for _ in 0..MAX_NEWTON_ITERATIONS {
-        // Bond vectors and residuals under the current multipliers.
-        let d = &s.directions;
+        // Bond vectors and residuals under the current multipliers, and the Jacobian's diagonal.
         let mut worst = 0.0f64;
+        let mut scale = 0.0f64;
         for k in 0..m {
-            let mut b = p[k + 1] - p[k] + d[k] * ((w(k) + w(k + 1)) * s.lambda[k]);
+            let mut b = p[k + 1] - p[k] + d[k] * ((w(k) + w(k + 1)) * lambda[k]);
             if k > 0 {
-                b -= d[k - 1] * (w(k) * s.lambda[k - 1]);
+                b -= d[k - 1] * (w(k) * lambda[k - 1]);
             }
             if k + 1 < m {
-                b -= d[k + 1] * (w(k + 1) * s.lambda[k + 1]);
+                b -= d[k + 1] * (w(k + 1) * lambda[k + 1]);
             }
             let l2 = lengths[k] as f64 * lengths[k] as f64;
             let f = b.length_squared() - l2;
-            s.bonds[k] = b;
-            s.residual[k] = -f;
+            bonds[k] = b;
+            residual[k] = -f;
             worst = worst.max((f / l2).abs());
+            diag[k] = 2.0 * (w(k) + w(k + 1)) * b.dot(d[k]);
+            scale = scale.max(diag[k].abs());
         }
         // Newton converges quadratically, so an iteration that fails to halve the error has reached the
         // rounding floor. (The system is solved in f64: its condition grows like n^2.)
@@ -112,58 +108,71 @@ fn newton_along_directions(p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f
             break;
         }
         previous_worst = worst;
-        // Jacobian of F_k = |b_k|^2 - l_k^2 with respect to the multipliers: tridiagonal.
-        for k in 0..m {
-            let b = s.bonds[k];
-            s.diag[k] = 2.0 * (w(k) + w(k + 1)) * b.dot(d[k]);
-            s.lower[k] = if k > 0 { -2.0 * w(k) * b.dot(d[k - 1]) } else { 0.0 };
-            s.upper[k] = if k + 1 < m { -2.0 * w(k + 1) * b.dot(d[k + 1]) } else { 0.0 };
-        }
-        if !thomas_solve(s, m) {
+        if !thomas_solve(d, bonds, diag, residual, c_prime, d_prime, lambda, dynamic_inv_mass, scale) {
             break;
         }
     }
     if !converged {
         return false;
     }
-    let d = &s.directions;
     for j in 1..=m {
-        let mut dp = d[j - 1] * s.lambda[j - 1];
+        let mut dp = d[j - 1] * lambda[j - 1];
         if j < m {
-            dp -= d[j] * s.lambda[j];
+            dp -= d[j] * lambda[j];
         }
         p[j] += dp * w(j);
     }
     true
 }
 
-/// Solves the tridiagonal system in `s` (diag, lower, upper, residual as right-hand side) and adds the
-/// solution to `s.lambda`. Returns `false` on a vanishing pivot or a non-finite result.
+/// Solves the Newton system `J delta = residual` and adds `delta` to `lambda`. `J` is tridiagonal: its
+/// diagonal is given (largest magnitude `scale`), its off-diagonal entries `d F_k / d lambda_(k-+1)` are
+/// formed during the forward sweep. Returns `false` on a vanishing pivot or a non-finite result.
 // `!(x > y)` on purpose: a NaN must fail the check too.
-#[allow(clippy::neg_cmp_op_on_partial_ord)]
-fn thomas_solve(s: &mut ConstraintScratch, m: usize) -> bool {
-    let scale = s.diag[..m].iter().fold(0.0f64, |a, b| a.max(b.abs()));
+#[allow(clippy::neg_cmp_op_on_partial_ord, clippy::too_many_arguments)]
+#[inline]
+fn thomas_solve(
+    d: &[DVec3],
+    bonds: &[DVec3],
+    diag: &[f64],
+    residual: &[f64],
+    c_prime: &mut [f64],
+    d_prime: &mut [f64],
+    lambda: &mut [f64],
+    dynamic_inv_mass: f64,
+    scale: f64,
+) -> bool {
+    let m = lambda.len();
+    let (d, bonds, diag, residual) = (&d[..m], &bonds[..m], &diag[..m], &residual[..m]);
+    let (c_prime, d_prime) = (&mut c_prime[..m], &mut d_prime[..m]);
+    let w = |j: usize| inv_mass(j, dynamic_inv_mass);
     let tiny = scale * 1e-7;
-    if !(scale > 0.0) || !(s.diag[0].abs() > tiny) {
+    if !(scale > 0.0) {
         return false;
     }
-    s.c_prime[0] = s.upper[0] / s.diag[0];
-    s.d_prime[0] = s.residual[0] / s.diag[0];
-    for k in 1..m {
-        let den = s.diag[k] - s.lower[k] * s.c_prime[k - 1];
+    // Forward elimination; one division per row.
+    let (mut c_last, mut d_last) = (0.0f64, 0.0f64);
+    for k in 0..m {
+        let b = bonds[k];
+        let lower = if k > 0 { -2.0 * w(k) * b.dot(d[k - 1]) } else { 0.0 };
+        let upper = if k + 1 < m { -2.0 * w(k + 1) * b.dot(d[k + 1]) } else { 0.0 };
+        let den = diag[k] - lower * c_last;
         if !(den.abs() > tiny) {
             return false;
         }
-        s.c_prime[k] = s.upper[k] / den;
-        s.d_prime[k] = (s.residual[k] - s.lower[k] * s.d_prime[k - 1]) / den;
+        let inv = 1.0 / den;
+        c_last = upper * inv;
+        d_last = (residual[k] - lower * d_last) * inv;
+        c_prime[k] = c_last;
+        d_prime[k] = d_last;
     }
     let mut next = 0.0f64;
     for k in (0..m).rev() {
-        let delta = s.d_prime[k] - s.c_prime[k] * next;
+        let delta = d_prime[k] - c_prime[k] * next;
         if !delta.is_finite() {
             return false;
         }
-        s.lambda[k] += delta;
+        lambda[k] += delta;
         next = delta;
     }
     true

@@ -10,8 +10,8 @@ use super::math::{Transform, align_hemisphere, nlerp_shorter};
 use super::polar::extract_rotation;
 use super::shape::Shape;
 
-/// Warm-started rotation extraction gains about 3x per iteration and starts from last substep's answer,
-/// so a few iterations reach float precision; it stops early once converged.
+/// Warm-started rotation extraction (Newton steps where the problem is well conditioned) reaches float
+/// precision in 2-3 iterations and stops early once converged; the cap only bounds the worst case.
 const POLAR_ITERATIONS: u32 = 8;
 
 /// Most rounds of (lengths, contacts) in the last solver iteration; they stop once the contacts move
@@ -264,31 +264,73 @@ fn match_shape(
     alpha: f32,
 ) {
     let n = p.len();
-    for i in 1..n {
-        let lo = i - 1;
-        let hi = (i + 1).min(n - 1);
-        let (rotation, centre, rest_centre) = if lo == 0 {
-            ((qp[0] * rest.orientations[0].inverse()).normalize(), p[0], rest.positions[0])
-        } else {
-            let count = (hi - lo + 1) as f32;
-            let c = p[lo..=hi].iter().sum::<DVec3>() / count as f64;
-            let c_rest = rest.positions[lo..=hi].iter().sum::<Vec3>() / count;
-            // Uniform masses cancel out of the group matrix.
-            let mut a = Mat3::ZERO;
-            for j in lo..=hi {
-                a += Mat3::from_quat(qp[j] * rest.orientations[j].inverse()) * orientation_weight;
-                let (pj, rj) = ((p[j] - c).as_vec3(), rest.positions[j] - c_rest);
-                a += Mat3::from_cols(pj * rj.x, pj * rj.y, pj * rj.z);
-            }
-            let mut rotation = group_rotation[i];
-            extract_rotation(&a, &mut rotation, POLAR_ITERATIONS);
-            (rotation, c, c_rest)
-        };
-        group_rotation[i] = rotation;
-        for j in lo.max(1)..=hi {
-            let goal = centre + (rotation * (rest.positions[j] - rest_centre)).as_dvec3();
-            p[j] += (goal - p[j]) * alpha as f64;
-        }
-        qp[i] = nlerp_shorter(qp[i], rotation * rest.orientations[i], alpha);
+    if n < 2 {
+        return;
     }
+    let (xbar, qbar, group_rotation) = (&rest.positions[..n], &rest.orientations[..n], &mut group_rotation[..n]);
+    let alpha_f64 = alpha as f64;
+
+    // The root's group {0, 1, 2}.
+    let rotation = (qp[0] * qbar[0].inverse()).normalize();
+    group_rotation[1] = rotation;
+    let (centre, rest_centre) = (p[0], xbar[0]);
+    for j in 1..n.min(3) {
+        pull_to_goal(&mut p[j], centre, rotation * (xbar[j] - rest_centre), alpha_f64);
+    }
+    qp[1] = nlerp_shorter(qp[1], rotation * qbar[1], alpha);
+
+    // A member's orientation term does not change between the group where it is the last member and the
+    // next one, where it is the middle member (a group only turns its middle particle): computed once.
+    let mut carried: Option<Mat3> = None;
+    for i in 2..n {
+        let lo = i - 1;
+        let full = i + 1 < n;
+        let orientation_term = |j: usize| Mat3::from_quat(qp[j] * qbar[j].inverse()) * orientation_weight;
+        let m_lo = orientation_term(lo);
+        let m_mid = carried.take().unwrap_or_else(|| orientation_term(i));
+        // Uniform masses cancel out of the group matrix.
+        let (c, a, r_lo, r_mid, r_hi) = if full {
+            let hi = i + 1;
+            let m_hi = orientation_term(hi);
+            carried = Some(m_hi);
+            let c = (DVec3::ZERO + p[lo] + p[i] + p[hi]) / 3.0;
+            let c_rest = (Vec3::ZERO + xbar[lo] + xbar[i] + xbar[hi]) / 3.0;
+            let (r_lo, r_mid, r_hi) = (xbar[lo] - c_rest, xbar[i] - c_rest, xbar[hi] - c_rest);
+            let a = m_lo
+                + outer((p[lo] - c).as_vec3(), r_lo)
+                + m_mid
+                + outer((p[i] - c).as_vec3(), r_mid)
+                + m_hi
+                + outer((p[hi] - c).as_vec3(), r_hi);
+            (c, a, r_lo, r_mid, r_hi)
+        } else {
+            let c = (DVec3::ZERO + p[lo] + p[i]) / 2.0;
+            let c_rest = (Vec3::ZERO + xbar[lo] + xbar[i]) / 2.0;
+            let (r_lo, r_mid) = (xbar[lo] - c_rest, xbar[i] - c_rest);
+            let a = m_lo + outer((p[lo] - c).as_vec3(), r_lo) + m_mid + outer((p[i] - c).as_vec3(), r_mid);
+            (c, a, r_lo, r_mid, Vec3::ZERO)
+        };
+        let mut rotation = group_rotation[i];
+        extract_rotation(&a, &mut rotation, POLAR_ITERATIONS);
+        group_rotation[i] = rotation;
+        pull_to_goal(&mut p[lo], c, rotation * r_lo, alpha_f64);
+        pull_to_goal(&mut p[i], c, rotation * r_mid, alpha_f64);
+        if full {
+            pull_to_goal(&mut p[i + 1], c, rotation * r_hi, alpha_f64);
+        }
+        qp[i] = nlerp_shorter(qp[i], rotation * qbar[i], alpha);
+    }
+}
+
+/// `p` moved the fraction `alpha` of the way to its shape-matching goal `centre + offset`.
+#[inline(always)]
+fn pull_to_goal(p: &mut DVec3, centre: DVec3, offset: Vec3, alpha: f64) {
+    let goal = centre + offset.as_dvec3();
+    *p += (goal - *p) * alpha;
+}
+
+/// `u v^T`.
+#[inline(always)]
+fn outer(u: Vec3, v: Vec3) -> Mat3 {
+    Mat3::from_cols(u * v.x, u * v.y, u * v.z)
 }

@@ -11,10 +11,23 @@ use super::math::{Transform, direction, normalized_rotation, shortest_arc};
 use super::params::MAX_COORDINATE;
 
 /// A validated shape: positions and unit orientations in the anchor frame.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct Shape {
     pub positions: Vec<Vec3>,
     pub orientations: Vec<Quat>,
+}
+
+/// By hand so that `clone_from` reuses the buffers: the step copies rest shapes every time they change, and
+/// the derived `clone_from` would allocate each time.
+impl Clone for Shape {
+    fn clone(&self) -> Self {
+        Self { positions: self.positions.clone(), orientations: self.orientations.clone() }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.positions.clone_from(&source.positions);
+        self.orientations.clone_from(&source.orientations);
+    }
 }
 
 /// Segments shorter than this fraction of the chain's extent count as zero length.
@@ -72,10 +85,22 @@ impl Shape {
 
 /// The part of a shape that view shapes control: bend rotations `r_0..r_{n-2}` and orientations
 /// `o_0..o_{n-1}`.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct EncodedShape {
     pub bends: Vec<Quat>,
     pub orientations: Vec<Quat>,
+}
+
+/// By hand so that `clone_from` reuses the buffers (see [`Shape`]'s).
+impl Clone for EncodedShape {
+    fn clone(&self) -> Self {
+        Self { bends: self.bends.clone(), orientations: self.orientations.clone() }
+    }
+
+    fn clone_from(&mut self, source: &Self) {
+        self.bends.clone_from(&source.bends);
+        self.orientations.clone_from(&source.orientations);
+    }
 }
 
 /// What all shapes of a chain share: the root position, the reference direction of `r_0`, and the

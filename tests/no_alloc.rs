@@ -1,0 +1,139 @@
+//! Hot loops allocate nothing (SPEC 6.3, issue 5): after a warm-up, a frame (anchors, collider poses, step
+//! with view shapes and colliders, read-back) makes no heap allocation, through the Rust API and through the C
+//! ABI. A counting global allocator measures it; this file holds one test so nothing else runs meanwhile.
+
+mod common;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use common::*;
+use glam::{Quat, Vec3};
+use kodawari::{AnchorSource, ChainParams, ColliderDef, ColliderShape, Engine, EngineSettings, Transform};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator unchanged; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: the caller's contract, passed on.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: the caller's contract, passed on.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: the caller's contract, passed on.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+const HEAD: Vec3 = Vec3::new(0.0, 1.6, 0.0);
+
+fn scene() -> (Engine, usize, usize) {
+    let mut engine = engine_with(EngineSettings::default());
+    for c in 0..6 {
+        let params = ChainParams {
+            anchor: if c % 2 == 0 { AnchorSource::ViewReference } else { AnchorSource::Own },
+            damping: if c == 5 { 20.0 } else { 1.0 },
+            ..Default::default()
+        };
+        let direction = Vec3::new(1.0, -0.5 * c as f32, 0.3);
+        let id = engine.create_chain(params, &straight_chain(5 + c, Vec3::ZERO, direction, 0.04)).unwrap();
+        if c < 4 {
+            let side = curled_chain(5 + c, Vec3::ZERO, direction, Vec3::Z, 0.2, 0.04);
+            engine.add_view_shape(id, Vec3::X, &side, 1.0).unwrap();
+            engine.add_view_shape(id, -Vec3::X, &side, 2.0).unwrap();
+        }
+    }
+    let head = ColliderDef { shape: ColliderShape::Sphere { radius: 0.1 }, transform: at(HEAD), layers: 1 };
+    let arm = ColliderDef {
+        shape: ColliderShape::Capsule { radius: 0.04, half_height: 0.2 },
+        transform: at(HEAD + Vec3::new(0.2, -0.2, 0.0)),
+        layers: 1,
+    };
+    engine.create_collider(&head).unwrap();
+    engine.create_collider(&arm).unwrap();
+    let joints = engine.joint_count();
+    (engine, 6, joints)
+}
+
+fn frame(engine: &mut Engine, n: usize, anchors: &mut [Transform], out: &mut [Transform], rotations: &mut [Quat]) {
+    let angle = n as f32 * 0.05;
+    let k = Transform::new(HEAD + Vec3::X * 0.1 * angle.sin(), Quat::from_rotation_y(0.3 * angle.cos()));
+    for a in anchors.iter_mut() {
+        *a = k;
+    }
+    let arm = at(HEAD + Vec3::new(0.2 * angle.cos(), -0.2, 0.0));
+    engine.set_collider_transforms([at(HEAD), arm].into_iter()).unwrap();
+    // Frame times vary (0 to 3 substeps) and the camera orbits, so the blend changes every frame.
+    let dt = [1.0 / 60.0, 1.0 / 144.0, 1.0 / 30.0][n % 3];
+    engine.step_with_anchors(anchors.iter().copied(), dt, orbit_camera(HEAD, 3.0, angle), k).unwrap();
+    engine.read_world(out).unwrap();
+    engine.read_local_rotations(rotations).unwrap();
+}
+
+#[test]
+fn a_frame_allocates_nothing() {
+    let (mut engine, chains, joints) = scene();
+    let mut anchors = vec![Transform::IDENTITY; chains];
+    let mut out = vec![Transform::IDENTITY; joints];
+    let mut rotations = vec![Quat::IDENTITY; joints];
+    for n in 0..30 {
+        frame(&mut engine, n, &mut anchors, &mut out, &mut rotations);
+    }
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    for n in 30..330 {
+        frame(&mut engine, n, &mut anchors, &mut out, &mut rotations);
+    }
+    let rust_allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+
+    // The same frame through the C ABI's one-call path.
+    use kodawari::ffi::engine::*;
+    use kodawari::ffi::types::*;
+    let mut handle = std::ptr::null_mut();
+    assert_eq!(kdw_engine_create(&kdw_engine_def_default(), &mut handle), 0);
+    let joints_c: Vec<kdw_transform> =
+        straight_chain(8, Vec3::ZERO, Vec3::X, 0.05).into_iter().map(Into::into).collect();
+    let mut chain = 0;
+    let def = kodawari::ffi::chain::kdw_chain_def_default();
+    assert_eq!(kodawari::ffi::chain::kdw_chain_create(handle, &def, joints_c.as_ptr(), 8, &mut chain), 0);
+    let k: kdw_transform = at(HEAD).into();
+    let anchor = [k];
+    let mut local = vec![kdw_quat::default(); 8];
+    let mut written = 0;
+    let mut c_frame = |n: usize| {
+        let camera: kdw_vec3 = orbit_camera(HEAD, 3.0, n as f32 * 0.05).into();
+        let status = kdw_engine_step_and_read(
+            handle,
+            1.0 / 60.0,
+            &camera,
+            &k,
+            anchor.as_ptr(),
+            1,
+            local.as_mut_ptr(),
+            8,
+            &mut written,
+        );
+        assert_eq!(status, 0);
+    };
+    for n in 0..30 {
+        c_frame(n);
+    }
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    for n in 30..330 {
+        c_frame(n);
+    }
+    let c_allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+    assert_eq!(kdw_engine_destroy(handle), 0);
+    println!("allocations over 300 frames: Rust API {rust_allocations}, C ABI {c_allocations}");
+    assert_eq!((rust_allocations, c_allocations), (0, 0));
+}

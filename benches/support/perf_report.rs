@@ -1,0 +1,713 @@
+//! Collecting the performance benchmark's numbers and writing `docs/performance.md`.
+//!
+//! Frame times come from criterion's own measurement loop: every `iter_custom` call of a benchmark records
+//! its time per frame here, and the median over the calls of its measurement phase (the last
+//! `sample_size` calls; the warm-up calls come first) is the same statistic criterion prints as the median.
+#![allow(dead_code)]
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::hint::black_box;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+// ---- allocation counting -----------------------------------------------------------------------------
+
+/// The system allocator, counting allocations, so the report can show that a frame allocates nothing.
+pub struct CountingAllocator;
+
+static ALLOCATIONS: AtomicU64 = AtomicU64::new(0);
+
+// SAFETY: every call is forwarded unchanged to the system allocator; only a counter is added.
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: the caller's contract for `alloc` is passed on as it is.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: `ptr` came from `System.alloc` with this layout.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: as for `alloc`.
+        unsafe { System.alloc_zeroed(layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: `ptr` came from this allocator with `layout`; the caller guarantees `new_size`.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+/// Allocations (including reallocations) per call of `frame`, over `frames` calls.
+pub fn allocations_per_frame(frames: u32, mut frame: impl FnMut()) -> f64 {
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    for _ in 0..frames {
+        frame();
+    }
+    (ALLOCATIONS.load(Ordering::Relaxed) - before) as f64 / frames as f64
+}
+
+// ---- timing ---------------------------------------------------------------------------------------------
+
+pub fn median(mut values: Vec<f64>) -> f64 {
+    assert!(!values.is_empty(), "median of nothing");
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) }
+}
+
+/// Time per frame of every `iter_custom` call, per benchmark id.
+#[derive(Default)]
+pub struct Recorder {
+    samples: RefCell<BTreeMap<String, Vec<f64>>>,
+}
+
+impl Recorder {
+    /// Runs `iters` frames, records the time per frame under `id`, and returns the total for criterion.
+    pub fn time(&self, id: &str, iters: u64, mut frame: impl FnMut()) -> Duration {
+        let start = Instant::now();
+        for _ in 0..iters {
+            frame();
+        }
+        let elapsed = start.elapsed();
+        self.samples.borrow_mut().entry(id.to_owned()).or_default().push(elapsed.as_secs_f64() / iters as f64);
+        elapsed
+    }
+
+    /// Median seconds per frame over the last `sample_size` calls (criterion's measurement phase), `None` if
+    /// the benchmark did not run (filtered out).
+    pub fn median_frame(&self, id: &str, sample_size: usize) -> Option<f64> {
+        let samples = self.samples.borrow();
+        let all = samples.get(id)?;
+        Some(median(all[all.len().saturating_sub(sample_size)..].to_vec()))
+    }
+}
+
+/// A ratio measured by interleaving two runs (A B, then B A, ...) so that a load change on the shared
+/// machine hits both alike; the median over rounds of (time of B / time of A).
+#[derive(Clone, Debug)]
+pub struct PairedRatio {
+    pub what: String,
+    pub a: String,
+    pub b: String,
+    pub a_seconds: f64,
+    pub b_seconds: f64,
+    pub ratio: f64,
+    pub rounds: usize,
+}
+
+/// Interleaves blocks of frames of `a` and `b` for `rounds` rounds; each block lasts about `block`.
+pub fn paired_ratio(
+    what: &str,
+    (a_name, mut a): (&str, &mut dyn FnMut()),
+    (b_name, mut b): (&str, &mut dyn FnMut()),
+    rounds: usize,
+    block: Duration,
+) -> PairedRatio {
+    let once = |f: &mut dyn FnMut()| {
+        let start = Instant::now();
+        f();
+        start.elapsed().as_secs_f64()
+    };
+    // Calibrate the block length on the slower of the two (after one warm frame each).
+    once(&mut a);
+    once(&mut b);
+    let frame = once(&mut a).max(once(&mut b)).max(1e-9);
+    let frames = ((block.as_secs_f64() / frame).ceil() as u64).max(1);
+    let run = |f: &mut dyn FnMut()| {
+        let start = Instant::now();
+        for _ in 0..frames {
+            f();
+        }
+        start.elapsed().as_secs_f64() / frames as f64
+    };
+    let (mut ta, mut tb, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+    for round in 0..rounds {
+        let (x, y) = if round % 2 == 0 {
+            let x = run(&mut a);
+            (x, run(&mut b))
+        } else {
+            let y = run(&mut b);
+            (run(&mut a), y)
+        };
+        ta.push(x);
+        tb.push(y);
+        ratios.push(y / x);
+    }
+    PairedRatio {
+        what: what.into(),
+        a: a_name.into(),
+        b: b_name.into(),
+        a_seconds: median(ta),
+        b_seconds: median(tb),
+        ratio: median(ratios),
+        rounds,
+    }
+}
+
+// ---- the machine ----------------------------------------------------------------------------------------
+
+pub struct Machine {
+    pub cpu_model: String,
+    /// Logical CPUs (`/proc/cpuinfo` processors) and what the process may use.
+    pub processors: usize,
+    pub available_parallelism: usize,
+    pub mhz: Option<f64>,
+    pub simd_flags: Vec<String>,
+    pub l3_cache: Option<String>,
+    pub load_average: Option<String>,
+    pub rustc: Option<String>,
+    /// Single-thread streaming bandwidth (bytes/s), measured here.
+    pub bandwidth: f64,
+}
+
+impl Machine {
+    pub fn probe() -> Self {
+        let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+        let field = |name: &str| {
+            cpuinfo
+                .lines()
+                .find(|l| l.split(':').next().is_some_and(|k| k.trim() == name))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_owned())
+        };
+        let flags = field("flags").unwrap_or_default();
+        let simd_flags = ["sse4_2", "avx", "avx2", "fma", "avx512f", "neon", "asimd"]
+            .iter()
+            .filter(|f| flags.split_whitespace().any(|x| x == **f))
+            .map(|f| f.to_string())
+            .collect();
+        let read = |path: &str| std::fs::read_to_string(path).ok().map(|s| s.trim().to_owned());
+        let rustc = std::process::Command::new("rustc")
+            .arg("-V")
+            .output()
+            .ok()
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned());
+        Self {
+            cpu_model: field("model name").unwrap_or_else(|| "unknown".into()),
+            processors: cpuinfo.lines().filter(|l| l.starts_with("processor")).count(),
+            available_parallelism: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            mhz: field("cpu MHz").and_then(|v| v.parse().ok()),
+            simd_flags,
+            l3_cache: read("/sys/devices/system/cpu/cpu0/cache/index3/size"),
+            load_average: read("/proc/loadavg"),
+            rustc,
+            bandwidth: stream_bandwidth(),
+        }
+    }
+}
+
+/// Single-thread memory bandwidth: the best of a few passes of `b[i] = s * a[i]` over two 64 MiB arrays
+/// (twice the last-level cache of most machines), counting 16 bytes per element as STREAM does.
+fn stream_bandwidth() -> f64 {
+    const ELEMENTS: usize = 8 << 20;
+    let a = vec![1.0f64; ELEMENTS];
+    let mut b = vec![0.0f64; ELEMENTS];
+    let mut best = f64::INFINITY;
+    for pass in 0..6 {
+        let s = black_box(1.0 + pass as f64);
+        let start = Instant::now();
+        for (y, x) in b.iter_mut().zip(&a) {
+            *y = s * x;
+        }
+        black_box(&mut b);
+        best = best.min(start.elapsed().as_secs_f64());
+    }
+    (16 * ELEMENTS) as f64 / best
+}
+
+// ---- a lower bound for the rod --------------------------------------------------------------------------
+
+/// Work of one internal substep per dynamic joint at default settings, counted from the code in
+/// `src/core/rod.rs`, `polar.rs` and `inextensible.rs`. Counting rule: add, multiply, divide and square root
+/// 1 operation each; sin, cos, acos 20 each. Loop control, comparisons and conversions are free. Where
+/// the code iterates to a tolerance, the minimum it runs is counted (1 polar iteration per group, one
+/// Newton update per inextensibility solve), so the total is a lower bound for this algorithm.
+pub const SUBSTEP_OPERATIONS: [(&str, f64); 5] = [
+    // Velocity update relative to the root (12), angular decay (3), position predict in f64 (6), rotation
+    // predict: scaled axis to quaternion (~55 with one sin_cos), quaternion product (28), normalise (13).
+    ("predict", 117.0),
+    // Per iteration (2 at default): group centroid and rest centroid (18); per particle of the group (3):
+    // rotation to rest (28), quaternion to matrix (24), weighted add (18), outer product and add (24) = 94;
+    // one polar iteration (~174: matrix from quaternion, 3 cross and 3 dot products, axis-angle with one
+    // sin_cos, product, normalise) plus its guard (18); goals for 3 particles (3 x 45); orientation nlerp
+    // (60). 18 + 282 + 192 + 135 + 60 = 687, times 2.
+    ("shape matching, 2 iterations", 1374.0),
+    // Per iteration and bond: directions (3), two residual evaluations (2 x 35), Jacobian (22), Thomas
+    // forward and back (10), applying the multipliers (15) = 120, times 2.
+    ("inextensibility, 2 iterations", 240.0),
+    // Linear velocity (6), relative rotation (28), hemisphere and scaled axis with one acos (~36), scale (3).
+    ("velocities", 73.0),
+    // Per frame, shared by the 4 substeps of a 60 Hz frame: local capture (2 x ~40), interpolated output
+    // (~60), world read-back (~35) = 175 / 4.
+    ("output and read-back, per substep share", 44.0),
+];
+
+/// Bytes a frame streams per joint when the scene does not fit in cache (the chain loop runs all substeps
+/// of a chain back to back, so within a frame a chain's data stays in L1 after its first substep).
+pub const FRAME_BYTES: [(&str, f64); 5] = [
+    // RodState: x DVec3 24 + v Vec3 12 + q Quat 16 + w Vec3 12 + group_rotation Quat 16 = 80, read and written.
+    ("particle state (80 B, read + write)", 160.0),
+    // rest and rest_used (Vec3 + Quat = 28 B each), segment length (4 B).
+    ("rest shapes and lengths (read)", 60.0),
+    // local_previous / local_current: one Transform (28 B) written each of the last two substeps.
+    ("render states (write)", 56.0),
+    // Output: both render states read (56), output written (28), bone axis read (12).
+    ("interpolated output", 96.0),
+    // read_world: output read (28), host buffer written (28).
+    ("host read-back", 56.0),
+];
+
+/// Bytes of engine data per joint that a frame touches (state 80, rest shapes 56, length 4, render states
+/// 56, output 28, bone axis 12): what must fit in cache for a scene to run out of cache.
+pub const WORKING_SET_BYTES_PER_JOINT: f64 = 236.0;
+
+pub struct Bound {
+    pub operations_per_joint_substep: f64,
+    pub bytes_per_joint_frame: f64,
+    /// Seconds per joint per substep if the operations ran at the scalar peak.
+    pub scalar_compute: Option<f64>,
+    /// Same for an 8-lane f32 SIMD path (AVX2) at its peak.
+    pub simd8_compute: Option<f64>,
+    /// Seconds per joint per substep to stream the frame's bytes at the measured bandwidth.
+    pub memory: f64,
+}
+
+/// Scalar peak assumption: 4 floating-point operations per cycle (two multiply/FMA pipes and two add pipes,
+/// fusion not counted), as on current x86-64 and aarch64 cores.
+pub const SCALAR_OPERATIONS_PER_CYCLE: f64 = 4.0;
+pub const SIMD_LANES: f64 = 8.0;
+
+impl Bound {
+    pub fn new(machine: &Machine, substeps_per_frame: f64) -> Self {
+        let operations: f64 = SUBSTEP_OPERATIONS.iter().map(|(_, n)| n).sum();
+        let bytes: f64 = FRAME_BYTES.iter().map(|(_, n)| n).sum();
+        let scalar = machine.mhz.map(|mhz| operations / (SCALAR_OPERATIONS_PER_CYCLE * mhz * 1e6));
+        Self {
+            operations_per_joint_substep: operations,
+            bytes_per_joint_frame: bytes,
+            scalar_compute: scalar,
+            simd8_compute: scalar.map(|s| s / SIMD_LANES),
+            memory: bytes / substeps_per_frame / machine.bandwidth,
+        }
+    }
+}
+
+// ---- the report -----------------------------------------------------------------------------------------
+
+/// Per-frame figures read over a few frames after a benchmark.
+#[derive(Clone, Copy, Debug)]
+pub struct Counters {
+    /// Heap allocations (the hot loop should make none).
+    pub allocations: f64,
+    /// Substeps where the direct inextensibility solve fell back (`Stats::solver_fallbacks`).
+    pub solver_fallbacks: f64,
+    /// (segment or particle, collider) pairs tested (`Stats::contact_pairs_tested`).
+    pub contact_pairs: f64,
+}
+
+/// One (scene, variant) benchmark.
+#[derive(Clone, Debug)]
+pub struct SceneRow {
+    pub scene: &'static str,
+    pub shape: String,
+    pub variant: &'static str,
+    pub variant_label: &'static str,
+    pub chains: usize,
+    pub joints: usize,
+    pub dynamic_joints: usize,
+    pub substeps: u32,
+    pub frame_seconds: Option<f64>,
+    pub counters: Option<Counters>,
+    /// Why it did not run, when it did not.
+    pub missing: Option<String>,
+    /// Anything the reader must know about the measurement (e.g. not every chain fell asleep).
+    pub note: Option<String>,
+}
+
+impl SceneRow {
+    pub fn ns_per_joint_substep(&self) -> Option<f64> {
+        let work = (self.dynamic_joints as f64) * (self.substeps.max(1) as f64);
+        self.frame_seconds.map(|s| s * 1e9 / work)
+    }
+}
+
+/// One engine on one peer scenario.
+#[derive(Clone, Debug)]
+pub struct PeerRow {
+    pub scenario: String,
+    pub engine: String,
+    pub substeps_per_frame: usize,
+    pub dynamic_joints: usize,
+    pub frame_seconds: Option<f64>,
+    /// RMS joint error / chain length against the exact pendulum over 0.5 s at 60 fps (pendulums only):
+    /// at the time the output represents, and at the call time.
+    pub error_physics: Option<f64>,
+    pub error_seen: Option<f64>,
+    pub note: String,
+}
+
+/// A skip of SPEC 3.8: a variant against its baseline on one scene.
+pub struct Skip {
+    pub what: &'static str,
+    pub baseline: &'static str,
+    pub with: &'static str,
+}
+
+pub enum Verdict {
+    Met,
+    Missed,
+    NotMeasured,
+}
+
+pub struct Target {
+    pub target: String,
+    pub measured: String,
+    pub verdict: Verdict,
+}
+
+impl Target {
+    pub fn check(target: &str, measured: String, met: Option<bool>) -> Self {
+        let verdict = match met {
+            Some(true) => Verdict::Met,
+            Some(false) => Verdict::Missed,
+            None => Verdict::NotMeasured,
+        };
+        Self { target: target.into(), measured, verdict }
+    }
+}
+
+#[derive(Default)]
+pub struct Report {
+    pub scenes: Vec<SceneRow>,
+    pub skips: Vec<Skip>,
+    pub ffi: Vec<(String, Option<f64>)>,
+    pub paired: Vec<PairedRatio>,
+    pub peers: Vec<PeerRow>,
+    pub peer_notes: Vec<String>,
+    pub targets: Vec<Target>,
+    pub notes: Vec<String>,
+}
+
+pub fn micros(seconds: Option<f64>) -> String {
+    match seconds {
+        Some(s) if s * 1e6 >= 100.0 => format!("{:.0}", s * 1e6),
+        Some(s) => format!("{:.1}", s * 1e6),
+        None => "not run".into(),
+    }
+}
+
+fn ns(value: Option<f64>) -> String {
+    value.map_or_else(|| "not run".into(), |v| format!("{v:.0}"))
+}
+
+pub fn error(value: Option<f64>) -> String {
+    value.map_or_else(|| "-".into(), |v| format!("{v:.2e}"))
+}
+
+impl Report {
+    pub fn scene(&self, scene: &str, variant: &str) -> Option<&SceneRow> {
+        self.scenes.iter().find(|r| r.scene == scene && r.variant == variant)
+    }
+
+    pub fn paired(&self, what: &str) -> Option<&PairedRatio> {
+        self.paired.iter().find(|p| p.what == what)
+    }
+
+    /// The markdown page.
+    pub fn markdown(&self, machine: &Machine, simd_path: &str, bound: &Bound, wall: Duration) -> String {
+        let mut md = String::new();
+        let _ = write!(
+            md,
+            "# Performance (SPEC 6.3)\n\nGenerated by `cargo bench --bench performance --features peers` \
+             (`benches/performance.rs`, scenes in `benches/support/scenes.rs`); do not edit by hand. One thread, \
+             release build, default engine settings (240 Hz internal steps: {} substeps per 60 Hz frame, 2 \
+             iterations). A frame is what a host does at 60 Hz: pose the heads (swaying and turning), per-chain \
+             anchors and collider poses, `step_with_anchors`, then `read_world`. Times are medians of criterion's \
+             samples, all from one run of {:.0} s. *ns/joint/substep* divides the frame time by the dynamic joints \
+             (all but each chain's root) and the substeps.\n\n",
+            self.scenes.first().map_or(4, |r| r.substeps),
+            wall.as_secs_f64()
+        );
+        self.machine_section(&mut md, machine, simd_path);
+        self.targets_section(&mut md);
+        self.scenes_section(&mut md);
+        self.skips_section(&mut md);
+        self.ffi_section(&mut md);
+        self.linearity_section(&mut md);
+        self.peer_section(&mut md);
+        self.bound_section(&mut md, bound);
+        if !self.notes.is_empty() {
+            md.push_str("## Notes\n\n");
+            for note in &self.notes {
+                let _ = writeln!(md, "- {note}");
+            }
+        }
+        md
+    }
+
+    fn machine_section(&self, md: &mut String, machine: &Machine, simd_path: &str) {
+        md.push_str("## Machine\n\n| fact | value |\n|---|---|\n");
+        let rows = [
+            ("CPU model (/proc/cpuinfo)", machine.cpu_model.clone()),
+            (
+                "logical CPUs (nproc)",
+                format!("{} ({} available to the process)", machine.processors, machine.available_parallelism),
+            ),
+            ("clock (cpu MHz)", machine.mhz.map_or("unknown".into(), |m| format!("{m:.0} MHz"))),
+            ("SIMD features", machine.simd_flags.join(", ")),
+            ("L3 cache", machine.l3_cache.clone().unwrap_or_else(|| "unknown".into())),
+            ("single-thread stream bandwidth (measured)", format!("{:.1} GB/s", machine.bandwidth / 1e9)),
+            ("load average at start", machine.load_average.clone().unwrap_or_else(|| "unknown".into())),
+            ("compiler", machine.rustc.clone().unwrap_or_else(|| "unknown".into())),
+            ("solver path that ran", simd_path.to_owned()),
+        ];
+        for (fact, value) in rows {
+            let _ = writeln!(md, "| {fact} | {value} |");
+        }
+        md.push('\n');
+    }
+
+    fn targets_section(&self, md: &mut String) {
+        md.push_str("## Targets\n\n| target | measured | verdict |\n|---|---|---|\n");
+        for t in &self.targets {
+            let verdict = match t.verdict {
+                Verdict::Met => "met",
+                Verdict::Missed => "MISSED",
+                Verdict::NotMeasured => "not measured yet",
+            };
+            let _ = writeln!(md, "| {} | {} | {verdict} |", t.target, t.measured);
+        }
+        md.push('\n');
+    }
+
+    fn scenes_section(&self, md: &mut String) {
+        md.push_str(
+            "## Scenes\n\nCharacters of up to 100 chains (strands on the scalp, 2.5 cm segments, capped at 0.8 m per \
+             chain); chains are anchored to their character's head. *views*: 3 view shapes per chain; *colliders*: \
+             head sphere and two shoulder capsules per character and a ground plane; *camera still*: the camera \
+             rides with the head, so the view direction never changes; *at rest*: heads and camera still, chains \
+             settled; *LOD n*: `EngineSettings::lod` (fewer substeps: ns/joint/substep uses the substeps that ran). \
+             Read over 3 frames after each benchmark: heap allocations (a counting allocator), inextensibility \
+             solver fallbacks and contact pairs tested (`Stats`), per frame.\n\n\
+             | scene | chains x joints | dynamic joints | variant | ns/joint/substep | us/frame | allocs | fallbacks \
+             | contact pairs |\n\
+             |---|---|---|---|---|---|---|---|---|\n",
+        );
+        for r in &self.scenes {
+            let counter = |f: fn(&Counters) -> f64| r.counters.as_ref().map_or("-".into(), |c| format!("{:.1}", f(c)));
+            let counters = format!(
+                "{} | {} | {}",
+                counter(|c| c.allocations),
+                counter(|c| c.solver_fallbacks),
+                counter(|c| c.contact_pairs)
+            );
+            let time = match &r.missing {
+                Some(why) => (why.clone(), why.clone()),
+                None => (ns(r.ns_per_joint_substep()), micros(r.frame_seconds)),
+            };
+            let variant = match &r.note {
+                Some(note) => format!("{} ({note})", r.variant_label),
+                None => r.variant_label.to_owned(),
+            };
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {variant} | {} | {} | {counters} |",
+                r.scene, r.shape, r.dynamic_joints, time.0, time.1
+            );
+        }
+        md.push('\n');
+    }
+
+    fn skips_section(&self, md: &mut String) {
+        md.push_str(
+            "## What each skip saves (SPEC 3.8)\n\nRatio = frame time with the feature / frame time of the baseline, \
+             same scene, same run (criterion medians). Below 1: the variant is cheaper.\n\n\
+             | scene | skip | baseline | variant | baseline us/frame | variant us/frame | ratio |\n\
+             |---|---|---|---|---|---|---|\n",
+        );
+        let mut scenes: Vec<&str> = self.scenes.iter().map(|r| r.scene).collect();
+        scenes.dedup();
+        for scene in scenes {
+            for skip in &self.skips {
+                let (Some(a), Some(b)) = (self.scene(scene, skip.baseline), self.scene(scene, skip.with)) else {
+                    continue;
+                };
+                let ratio = match (a.frame_seconds, b.frame_seconds) {
+                    (Some(x), Some(y)) => format!("{:.2}", y / x),
+                    _ => "-".into(),
+                };
+                let _ = writeln!(
+                    md,
+                    "| {scene} | {} | {} | {} | {} | {} | {ratio} |",
+                    skip.what,
+                    a.variant_label,
+                    b.variant_label,
+                    micros(a.frame_seconds),
+                    micros(b.frame_seconds)
+                );
+            }
+        }
+        md.push('\n');
+        let paired: Vec<_> = self.paired.iter().filter(|p| !p.what.starts_with("C ABI")).collect();
+        if !paired.is_empty() {
+            md.push_str(
+                "Interleaved measurements (blocks of frames of A and B alternate, median over rounds of B / A), for \
+                 the ratios that should be 1:\n\n| what | A | B | A us/frame | B us/frame | B / A | rounds |\n\
+                 |---|---|---|---|---|---|---|\n",
+            );
+            for p in paired {
+                paired_row(md, p);
+            }
+            md.push('\n');
+        }
+    }
+
+    fn ffi_section(&self, md: &mut String) {
+        md.push_str(
+            "## C ABI overhead\n\n100 x 16 plain scene built and driven only through the `kdw_*` functions (the \
+             ones `include/kodawari.h` declares, called as a C host calls them) against the same frame in Rust. \
+             Criterion medians:\n\n| path | us/frame |\n|---|---|\n",
+        );
+        for (path, seconds) in &self.ffi {
+            let _ = writeln!(md, "| {path} | {} |", micros(*seconds));
+        }
+        md.push_str(
+            "\nInterleaved (the ratio the target uses):\n\n\
+             | what | A | B | A us/frame | B us/frame | B / A | rounds |\n\
+             |---|---|---|---|---|---|---|\n",
+        );
+        for p in self.paired.iter().filter(|p| p.what.starts_with("C ABI")) {
+            paired_row(md, p);
+        }
+        md.push('\n');
+    }
+
+    fn linearity_section(&self, md: &mut String) {
+        md.push_str("## Linearity\n\nns/joint/substep of the plain scenes (no view shapes, no colliders):\n\n");
+        md.push_str("| scene | dynamic joints | ns/joint/substep | / 1000 x 16 |\n|---|---|---|---|\n");
+        let reference = self.scene("1000x16", "plain").and_then(SceneRow::ns_per_joint_substep);
+        for r in self.scenes.iter().filter(|r| r.variant == "plain") {
+            let relative = match (r.ns_per_joint_substep(), reference) {
+                (Some(x), Some(y)) => format!("{:.2}", x / y),
+                _ => "-".into(),
+            };
+            let _ = writeln!(
+                md,
+                "| {} ({}) | {} | {} | {relative} |",
+                r.scene,
+                r.shape,
+                r.dynamic_joints,
+                ns(r.ns_per_joint_substep())
+            );
+        }
+        md.push('\n');
+    }
+
+    fn peer_section(&self, md: &mut String) {
+        md.push_str(
+            "## Side by side with rapier3d\n\nThe same scenes in rapier3d 0.30 (what a user would pick instead): one \
+             rigid body per joint, spherical joints, default `IntegrationParameters` at dt 1/60 s. Pendulum error: \
+             RMS joint position error over the dynamic joints and 30 frames (0.5 s at 60 fps) / chain length (1 m), \
+             against the exact reference of `benches/support/pendulum.rs` (the accuracy benchmark's). kodawari's \
+             output after a step ending at t is its state at t - 1/240 s (render interpolation): *physics* compares \
+             with the reference at that time, *as seen* at t (adds that latency); rapier's bodies are at t, so both \
+             of its columns are the same figure.\n\n\
+             | scenario | engine | substeps/frame | us/frame | ns/joint/substep | RMS error physics \
+             | RMS error as seen | note |\n\
+             |---|---|---|---|---|---|---|---|\n",
+        );
+        for p in &self.peers {
+            let per_joint =
+                p.frame_seconds.map(|s| s * 1e9 / (p.dynamic_joints as f64 * p.substeps_per_frame.max(1) as f64));
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                p.scenario,
+                p.engine,
+                p.substeps_per_frame,
+                micros(p.frame_seconds),
+                ns(per_joint),
+                error(p.error_physics),
+                error(p.error_seen),
+                p.note
+            );
+        }
+        md.push('\n');
+        for note in &self.peer_notes {
+            let _ = writeln!(md, "- {note}");
+        }
+        if !self.peer_notes.is_empty() {
+            md.push('\n');
+        }
+    }
+
+    fn bound_section(&self, md: &mut String, bound: &Bound) {
+        let measured = self.scene("1000x16", "plain").and_then(SceneRow::ns_per_joint_substep);
+        let _ = write!(
+            md,
+            "## Lower bound for 1000 x 16\n\nOperations per dynamic joint per substep, counted from the code at \
+             default settings (add, multiply, divide, square root = 1; sin, cos, acos = 20; where the code iterates \
+             to a tolerance the minimum it runs is counted, so this is a lower bound for the algorithm as written):\n\n\
+             | part | operations |\n|---|---|\n"
+        );
+        for (part, n) in SUBSTEP_OPERATIONS {
+            let _ = writeln!(md, "| {part} | {n:.0} |");
+        }
+        let _ = writeln!(md, "| total | {:.0} |\n", bound.operations_per_joint_substep);
+        md.push_str(
+            "Bytes per joint per frame streamed from memory when the scene does not fit in cache (a chain's substeps \
+             run back to back, so its data is loaded once per frame):\n\n| data | bytes |\n|---|---|\n",
+        );
+        for (part, n) in FRAME_BYTES {
+            let _ = writeln!(md, "| {part} | {n:.0} |");
+        }
+        let _ = writeln!(md, "| total | {:.0} |\n", bound.bytes_per_joint_frame);
+        let ratio = |b: Option<f64>| match (measured, b) {
+            (Some(m), Some(b)) => format!("{:.1}", m / (b * 1e9)),
+            _ => "-".into(),
+        };
+        let ns_of = |b: Option<f64>| b.map_or("-".into(), |b| format!("{:.1}", b * 1e9));
+        let _ = write!(
+            md,
+            "| bound (per joint per substep) | ns | measured / bound |\n|---|---|---|\n\
+             | compute, scalar peak ({SCALAR_OPERATIONS_PER_CYCLE:.0} operations/cycle at the clock above) \
+             | {} | {} |\n\
+             | compute, 8-lane f32 SIMD peak | {} | {} |\n\
+             | memory, measured stream bandwidth | {} | {} |\n\n\
+             Measured (1000 x 16, plain): {} ns/joint/substep. The 1000 x 16 working set (about {:.1} MB) fits in the \
+             L3 cache, so the memory line bounds the 16384 x 16 scene rather than this one; compute is the binding \
+             bound.\n\n",
+            ns_of(bound.scalar_compute),
+            ratio(bound.scalar_compute),
+            ns_of(bound.simd8_compute),
+            ratio(bound.simd8_compute),
+            ns_of(Some(bound.memory)),
+            ratio(Some(bound.memory)),
+            ns(measured),
+            16_000.0 * WORKING_SET_BYTES_PER_JOINT / 1e6,
+        );
+    }
+}
+
+fn paired_row(md: &mut String, p: &PairedRatio) {
+    let _ = writeln!(
+        md,
+        "| {} | {} | {} | {} | {} | {:.3} | {} |",
+        p.what,
+        p.a,
+        p.b,
+        micros(Some(p.a_seconds)),
+        micros(Some(p.b_seconds)),
+        p.ratio,
+        p.rounds
+    );
+}

@@ -179,7 +179,20 @@ fn collide_outside(
     let mut deepest = 0.0f32;
     let (radius, half_height) = sweep.shape.capsule().expect("outside colliders are spheres or capsules");
     let axis = (Vec3::new(0.0, -half_height, 0.0), Vec3::new(0.0, half_height, 0.0));
+    // Quick reject, in world space and conservative: a segment whose every point stays farther from the
+    // collider's centre than the collider's reach, over the whole substep, cannot touch it. Saves the frame
+    // changes and closest-point tests for the many segments of a long chain far from a collider.
+    let centre = sweep.end.centre;
+    let collider_travel = (sweep.end.centre - sweep.start.centre).length();
+    let solid = (radius + half_height) as f64;
     for k in 0..p.len() - 1 {
+        let half = (p[k + 1] - p[k]).length() * 0.5;
+        let travel = (p[k] - start[k]).length().max((p[k + 1] - start[k + 1]).length());
+        let thickness = input.radii[k].max(input.radii[k + 1]) as f64;
+        let clear = solid + thickness + half + travel + collider_travel;
+        if (p[k].midpoint(p[k + 1]) - centre).length_squared() > clear * clear {
+            continue;
+        }
         let (a, b) = (sweep.end.to_local(p[k]), sweep.end.to_local(p[k + 1]));
         let (mut t, _) = closest_between_segments((a, b), axis);
         // The root is kinematic: a contact next to it could only be met by a large turn of the segment.

@@ -6,6 +6,7 @@
 //   kodawari::Collider                    a collision shape of the engine: non-owning handle
 //   kodawari::EngineDef / ChainDef / ColliderDef  the C def structs, initialised to the library defaults
 //   kodawari::StrokeCamera, shapeFromStroke()  the sketch tool: a screen-space stroke -> a chain shape
+//   kodawari::stepEngines()               steps many engines in one call (kdw_engines_step)
 //
 // Errors: by default every failing call throws kodawari::Error (status + the library's message). Define
 // KODAWARI_NO_EXCEPTIONS before including this header to get no throws at all: the same methods then
@@ -251,7 +252,10 @@ private:
     uint32_t size_ = 0;
 };
 
-/// Engine settings, initialised to kdw_engine_def_default().
+/// Engine settings, initialised to kdw_engine_def_default(). The fields are the C struct's: gravity,
+/// substep_rate, max_substeps, iterations, time_scale, teleport_distance, teleport_angle, teleport_mode,
+/// sleep_speed (character units/s below which a still chain falls asleep; 0 never sleeps), lod (0-3: each
+/// level halves the step rate, not below 30 Hz, and the iterations, not below 1) and scale.
 struct EngineDef : kdw_engine_def {
     /// The library defaults.
     EngineDef() noexcept : kdw_engine_def(kdw_engine_def_default()) {}
@@ -397,6 +401,11 @@ public:
     }
     /// Moves the collider to other layers: it affects chains whose collision mask shares a bit.
     Ret<void> setLayers(uint32_t layers) const { return detail::check(kdw_collider_set_layers(engine_, id_, layers)); }
+    /// Resizes the collider, keeping its shape kind: `radius` and `halfHeight` in world units, validated as in
+    /// ColliderDef (e.g. when the bone it follows is scaled).
+    Ret<void> setSize(float radius, float halfHeight) const {
+        return detail::check(kdw_collider_set_size(engine_, id_, radius, halfHeight));
+    }
     /// Destroys the collider; this handle (and its copies) become invalid. Later colliders keep their order.
     Ret<void> destroy() const { return detail::check(kdw_collider_destroy(engine_, id_)); }
 
@@ -459,6 +468,24 @@ public:
     }
     /// Per-joint collision radii (one per joint); an empty span goes back to the def's radius for every joint.
     Ret<void> setJointRadii(Span<const float> radii) const { return setJointRadii(radii.data(), radii.size()); }
+    /// Enables or disables (culls) the chain. A disabled chain is not simulated and costs nothing: it rides
+    /// rigidly with its anchor in its last pose; enabled again it carries on from there without a whip.
+    Ret<void> setEnabled(bool enabled) const {
+        return detail::check(kdw_chain_set_enabled(engine_, id_, enabled ? 1u : 0u));
+    }
+    /// True if the chain is enabled (the default).
+    [[nodiscard]] Ret<bool> isEnabled() const {
+        uint32_t enabled = 0;
+        const kdw_status status = kdw_chain_is_enabled(engine_, id_, &enabled);
+        return detail::result(status, enabled != 0);
+    }
+    /// True if the chain slept through the last step (its anchor, rest shape and nearby colliders were still
+    /// and its motion had died out; see EngineDef::sleep_speed).
+    [[nodiscard]] Ret<bool> isAsleep() const {
+        uint32_t asleep = 0;
+        const kdw_status status = kdw_chain_is_asleep(engine_, id_, &asleep);
+        return detail::result(status, asleep != 0);
+    }
 
     /// Number of joints.
     [[nodiscard]] Ret<uint32_t> jointCount() const {
@@ -756,6 +783,37 @@ private:
 
     kdw_engine* handle_ = nullptr;
 };
+
+/// Steps several distinct engines by `dt` with one camera, `engines[i]` with its view reference
+/// `viewReferences[i]` (as Engine::step each), in one call: in parallel when the library is built with its
+/// `parallel` feature. `count` handles and references; every handle and input is checked before any engine
+/// moves (a null or empty engine, or one given twice, fails the whole call and changes nothing). Allocates
+/// nothing for up to 64 engines.
+inline Ret<void> stepEngines(Engine* const* engines, uint32_t count, float dt, const Vec3& camera,
+                             const Transform* viewReferences) {
+    // kdw_engine* handles on the stack for small batches, else on the heap (the call is per frame).
+    constexpr uint32_t kStackHandles = 64;
+    if (engines == nullptr) return detail::check(kdw_engines_step(nullptr, count, dt, &camera, viewReferences));
+    kdw_engine* stack[kStackHandles];
+    std::vector<kdw_engine*> heap;
+    kdw_engine** handles = stack;
+    if (count > kStackHandles) {
+        heap.resize(count);
+        handles = heap.data();
+    }
+    for (uint32_t i = 0; i < count; ++i) handles[i] = engines[i] != nullptr ? engines[i]->handle() : nullptr;
+    return detail::check(kdw_engines_step(handles, count, dt, &camera, viewReferences));
+}
+
+/// Steps several distinct engines in one call (see the pointer overload): `engines` and `viewReferences`
+/// must have the same size, else KDW_STATUS_INVALID_ARGUMENT and nothing moves.
+inline Ret<void> stepEngines(Span<Engine* const> engines, float dt, const Vec3& camera,
+                             Span<const Transform> viewReferences) {
+    if (engines.size() != viewReferences.size()) {
+        return detail::check(KDW_STATUS_INVALID_ARGUMENT, "stepEngines: one view reference per engine");
+    }
+    return stepEngines(engines.data(), engines.size(), dt, camera, viewReferences.data());
+}
 
 }  // inline namespace KODAWARI_DETAIL_MODE
 }  // namespace kodawari

@@ -1747,6 +1747,264 @@ static int test_engine_scale(void)
     return 0;
 }
 
+/* ---- culling, sleeping, batch stepping, collider resizing ---------------------------------------------------- */
+
+/* The head swinging sideways, turning about y and drifting forward: its pose at `frame`. */
+static kdw_transform moving_head(int frame)
+{
+    const float t = (float)frame * FRAME_DT;
+    const float angle = 0.6f * sinf(2.0f * t);
+    return xf(v3(0.4f * sinf(3.0f * t), 1.6f + 0.1f * t, 0.2f * t), q_axis_angle(0.0f, 1.0f, 0.0f, angle));
+}
+
+/* `point` in the rigid frame `frame`. */
+static kdw_vec3 position_in(kdw_transform frame, kdw_vec3 point)
+{
+    return q_rotate(q_conjugate(frame.rotation), v_sub(point, frame.position));
+}
+
+/* kdw_chain_set_enabled / kdw_chain_is_enabled: a disabled chain rides rigidly with its (moving, turning) anchor,
+ * is counted in chains_asleep while the others swing, and is simulated again once enabled. Values other than
+ * 0 and 1, NULL outputs and bad ids are rejected without changing the state. */
+static int test_chain_enabled(void)
+{
+    scene s;
+    ENSURE(scene_build(&s, 1) == 0);
+    const kdw_vec3 camera = v3(0.0f, 1.7f, 2.5f);
+    int frame = 0;
+    for (; frame < 30; ++frame) {
+        const kdw_transform head = moving_head(frame);
+        ENSURE_OK(kdw_engine_step(s.engine, FRAME_DT, &camera, &head));
+    }
+    uint32_t enabled = 7;
+    ENSURE_OK(kdw_chain_is_enabled(s.engine, s.chains[1], &enabled));
+    ENSURE(enabled == 1);
+
+    ENSURE_OK(kdw_chain_set_enabled(s.engine, s.chains[1], 0));
+    ENSURE_OK(kdw_chain_is_enabled(s.engine, s.chains[1], &enabled));
+    ENSURE(enabled == 0);
+    ENSURE_OK(kdw_chain_is_enabled(s.engine, s.chains[0], &enabled));
+    ENSURE(enabled == 1);
+    const uint32_t n = g_side_lock.n;
+    kdw_transform world[MAX_JOINTS];
+    kdw_vec3 frozen[MAX_JOINTS];
+    uint32_t written = 0;
+    ENSURE_OK(kdw_chain_read_world(s.engine, s.chains[1], world, MAX_JOINTS, &written));
+    ENSURE(written == n);
+    const kdw_transform at_cull = moving_head(frame - 1);
+    for (uint32_t j = 0; j < n; ++j) frozen[j] = position_in(at_cull, world[j].position);
+    double worst = 0.0;
+    for (int end = frame + 60; frame < end; ++frame) {
+        const kdw_transform head = moving_head(frame);
+        ENSURE_OK(kdw_engine_step(s.engine, FRAME_DT, &camera, &head));
+        ENSURE_OK(kdw_chain_read_world(s.engine, s.chains[1], world, MAX_JOINTS, &written));
+        for (uint32_t j = 0; j < n; ++j) worst = fmax(worst, v_dist(position_in(head, world[j].position), frozen[j]));
+        kdw_engine_stats stats;
+        ENSURE_OK(kdw_engine_get_stats(s.engine, &stats));
+        ENSURE(stats.chains_asleep == 1 && stats.chain_count == 3);
+    }
+    ENSURE(worst < 2e-6);
+    ENSURE(v_dist(moving_head(frame - 1).position, at_cull.position) > 0.2); /* the anchor really moved */
+
+    /* Rejected calls change nothing. */
+    const uint64_t hash = hash_of(s.engine);
+    ENSURE_STATUS(kdw_chain_set_enabled(s.engine, s.chains[1], 2), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_STATUS(kdw_chain_set_enabled(s.engine, 0, 1), KDW_STATUS_INVALID_ID);
+    ENSURE_STATUS(kdw_chain_set_enabled(s.engine, s.left, 1), KDW_STATUS_INVALID_ID); /* a view shape id */
+    ENSURE_STATUS(kdw_chain_set_enabled(NULL, s.chains[1], 1), KDW_STATUS_NULL_POINTER);
+    ENSURE_STATUS(kdw_chain_is_enabled(s.engine, s.chains[1], NULL), KDW_STATUS_NULL_POINTER);
+    ENSURE_STATUS(kdw_chain_is_asleep(s.engine, s.chains[1], NULL), KDW_STATUS_NULL_POINTER);
+    uint32_t untouched = 7;
+    ENSURE_STATUS(kdw_chain_is_asleep(s.engine, 0, &untouched), KDW_STATUS_INVALID_ID);
+    ENSURE(untouched == 7);
+    ENSURE(hash_of(s.engine) == hash);
+
+    /* Enabled again: simulated (not counted) from the next step on. */
+    ENSURE_OK(kdw_chain_set_enabled(s.engine, s.chains[1], 1));
+    ENSURE_OK(kdw_chain_set_enabled(s.engine, s.chains[1], 1)); /* idempotent */
+    const kdw_transform head = moving_head(frame - 1);
+    ENSURE_OK(kdw_engine_step(s.engine, FRAME_DT, &camera, &head));
+    kdw_engine_stats stats;
+    ENSURE_OK(kdw_engine_get_stats(s.engine, &stats));
+    ENSURE(stats.chains_asleep == 0);
+    ENSURE_OK(kdw_chain_is_enabled(s.engine, s.chains[1], &enabled));
+    ENSURE(enabled == 1);
+    return 0;
+}
+
+/* kdw_chain_is_asleep and sleep_speed: a damped chain (5/s) under a still head settles and sleeps within 5 s,
+ * counted in the stats; a moving head wakes it; with sleep_speed 0 the same chain never sleeps. lod 3 runs one
+ * substep per 1/60 s frame. */
+static int test_chain_sleeps(void)
+{
+    kdw_engine_def def = kdw_engine_def_default();
+    ENSURE(def.sleep_speed == 5e-6f && def.lod == 0);
+    kdw_engine *sleeper = engine_new(&def);
+    def.sleep_speed = 0.0f;
+    kdw_engine *awake = engine_new(&def);
+    ENSURE(sleeper != NULL && awake != NULL);
+    kdw_chain_def chain_def = kdw_chain_def_default();
+    chain_def.stiffness = 0.9f;
+    chain_def.damping = 5.0f;
+    kdw_chain_id a = 0, b = 0;
+    ENSURE_OK(kdw_chain_create(sleeper, &chain_def, g_ahoge_left.joints, g_ahoge_left.n, &a));
+    ENSURE_OK(kdw_chain_create(awake, &chain_def, g_ahoge_left.joints, g_ahoge_left.n, &b));
+    const kdw_transform head = head_at_rest();
+    const kdw_vec3 camera = v3(0.0f, 1.7f, 2.5f);
+    int fell_asleep = -1;
+    uint32_t asleep = 0;
+    for (int frame = 0; frame < 300; ++frame) {
+        ENSURE_OK(kdw_engine_step(sleeper, FRAME_DT, &camera, &head));
+        ENSURE_OK(kdw_engine_step(awake, FRAME_DT, &camera, &head));
+        ENSURE_OK(kdw_chain_is_asleep(sleeper, a, &asleep));
+        if (asleep && fell_asleep < 0) fell_asleep = frame;
+        ENSURE_OK(kdw_chain_is_asleep(awake, b, &asleep));
+        ENSURE(asleep == 0);
+    }
+    ENSURE(fell_asleep > 0);
+    ENSURE_OK(kdw_chain_is_asleep(sleeper, a, &asleep));
+    ENSURE(asleep == 1);
+    kdw_engine_stats stats;
+    ENSURE_OK(kdw_engine_get_stats(sleeper, &stats));
+    ENSURE(stats.chains_asleep == 1);
+    ENSURE_OK(kdw_engine_get_stats(awake, &stats));
+    ENSURE(stats.chains_asleep == 0);
+    printf("    damping 5/s: asleep after %.2f s\n", (double)((float)(fell_asleep + 1) * FRAME_DT));
+
+    const kdw_transform moved = xf(v3(0.05f, 1.6f, 0.0f), q_identity());
+    ENSURE_OK(kdw_engine_step(sleeper, FRAME_DT, &camera, &moved));
+    ENSURE_OK(kdw_chain_is_asleep(sleeper, a, &asleep));
+    ENSURE(asleep == 0);
+
+    kdw_engine_def far = kdw_engine_def_default();
+    far.lod = 3;
+    ENSURE_OK(kdw_engine_set_def(sleeper, &far));
+    ENSURE_OK(kdw_engine_get_def(sleeper, &def));
+    ENSURE(def.lod == 3 && def.sleep_speed == 5e-6f);
+    for (int frame = 0; frame < 6; ++frame) {
+        ENSURE_OK(kdw_engine_step(sleeper, FRAME_DT, &camera, &moved));
+        ENSURE_OK(kdw_engine_get_stats(sleeper, &stats));
+        ENSURE(stats.substeps_last_step <= 1);
+    }
+    return 0;
+}
+
+/* kdw_engines_step: four engines stepped in one call per frame end in exactly the states (hashes) of four
+ * engines stepped one by one; NULL, repeated handles and bad inputs fail the whole call and change no hash. */
+static int test_engines_step(void)
+{
+    enum { COUNT = 4 };
+    kdw_engine *batched[COUNT], *single[COUNT];
+    for (int i = 0; i < COUNT; ++i) {
+        kdw_engine **group[2] = {&batched[i], &single[i]};
+        for (int g = 0; g < 2; ++g) {
+            kdw_engine *e = engine_new_default();
+            ENSURE(e != NULL);
+            kdw_chain_def def = kdw_chain_def_default();
+            def.stiffness = 0.3f + 0.15f * (float)i;
+            kdw_chain_id chain = 0;
+            kdw_view_shape_id shape = 0;
+            kdw_vec3 left = v3(-1.0f, 0.0f, 0.0f);
+            ENSURE_OK(kdw_chain_create(e, &def, g_ahoge.joints, g_ahoge.n, &chain));
+            ENSURE_OK(kdw_chain_add_view_shape(e, chain, &left, g_ahoge_left.joints, g_ahoge_left.n, 1.0f, &shape));
+            *group[g] = e;
+        }
+    }
+    kdw_transform heads[COUNT];
+    for (int frame = 0; frame < 90; ++frame) {
+        for (int i = 0; i < COUNT; ++i)
+            heads[i] = xf(v3((float)i + 0.1f * sinf(0.2f * (float)frame), 1.6f, 0.0f), q_identity());
+        const kdw_vec3 camera = orbit_camera(frame);
+        ENSURE_OK(kdw_engines_step(batched, COUNT, FRAME_DT, &camera, heads));
+        for (int i = 0; i < COUNT; ++i) ENSURE_OK(kdw_engine_step(single[i], FRAME_DT, &camera, &heads[i]));
+    }
+    uint64_t hashes[COUNT];
+    for (int i = 0; i < COUNT; ++i) {
+        hashes[i] = hash_of(batched[i]);
+        ENSURE(hashes[i] != 0 && hashes[i] == hash_of(single[i]));
+        if (i > 0) ENSURE(hashes[i] != hashes[i - 1]);
+    }
+
+    const kdw_vec3 camera = orbit_camera(90);
+    kdw_engine *repeated[COUNT] = {batched[0], batched[1], batched[2], batched[1]};
+    ENSURE_STATUS(kdw_engines_step(repeated, COUNT, FRAME_DT, &camera, heads), KDW_STATUS_INVALID_ARGUMENT);
+    kdw_engine *with_null[COUNT] = {batched[0], batched[1], NULL, batched[3]};
+    ENSURE_STATUS(kdw_engines_step(with_null, COUNT, FRAME_DT, &camera, heads), KDW_STATUS_NULL_POINTER);
+    ENSURE_STATUS(kdw_engines_step(NULL, COUNT, FRAME_DT, &camera, heads), KDW_STATUS_NULL_POINTER);
+    ENSURE_STATUS(kdw_engines_step(batched, COUNT, FRAME_DT, NULL, heads), KDW_STATUS_NULL_POINTER);
+    ENSURE_STATUS(kdw_engines_step(batched, COUNT, FRAME_DT, &camera, NULL), KDW_STATUS_NULL_POINTER);
+    ENSURE_STATUS(kdw_engines_step(batched, COUNT, NAN, &camera, heads), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_STATUS(kdw_engines_step(batched, COUNT, -1.0f, &camera, heads), KDW_STATUS_INVALID_ARGUMENT);
+    kdw_transform bad_heads[COUNT];
+    memcpy(bad_heads, heads, sizeof heads);
+    bad_heads[COUNT - 1].rotation = q4(0.0f, 0.0f, 0.0f, 0.0f);
+    ENSURE_STATUS(kdw_engines_step(batched, COUNT, FRAME_DT, &camera, bad_heads), KDW_STATUS_INVALID_ARGUMENT);
+    const kdw_vec3 far_camera = v3(2e9f, 0.0f, 0.0f);
+    ENSURE_STATUS(kdw_engines_step(batched, COUNT, FRAME_DT, &far_camera, heads), KDW_STATUS_INVALID_ARGUMENT);
+    for (int i = 0; i < COUNT; ++i) ENSURE(hash_of(batched[i]) == hashes[i]);
+
+    ENSURE_OK(kdw_engines_step(NULL, 0, FRAME_DT, &camera, NULL)); /* nothing to step */
+    ENSURE_OK(kdw_engines_step(batched, 2, FRAME_DT, &camera, heads)); /* a prefix */
+    ENSURE(hash_of(batched[1]) != hashes[1] && hash_of(batched[2]) == hashes[2]);
+    ENSURE_OK(kdw_engines_step(batched, COUNT, 0.0f, &camera, heads)); /* dt 0 changes nothing */
+    ENSURE(hash_of(batched[2]) == hashes[2]);
+    return 0;
+}
+
+/* kdw_collider_set_size: a limp chain resting on a 0.1 m ball is pushed out to the surface of the same ball grown
+ * to 0.15 m; invalid sizes and ids are rejected without changing the state. */
+static int test_collider_set_size(void)
+{
+    const kdw_transform anchor = xf(v3(0.0f, 1.0f, 0.0f), q_identity());
+    const kdw_vec3 camera = v3(0.0f, 1.0f, 3.0f);
+    const kdw_vec3 centre = v3(0.2f, 0.82f, 0.0f);
+    kdw_engine *e = NULL;
+    kdw_chain_id chain = 0;
+    kdw_collider_id ball = 0;
+    ENSURE(drape_scene(&e, 0x2u, &chain, &ball, centre) == 0);
+    double small = 0.0, large = 0.0;
+    for (int frame = 0; frame < 120; ++frame) ENSURE_OK(kdw_engine_step(e, FRAME_DT, &camera, &anchor));
+    ENSURE(closest_joint(e, chain, centre, &small) == 0);
+    ENSURE(small >= BALL_RADIUS - 1e-4 && small < BALL_RADIUS + 3.5e-3);
+
+    const uint64_t hash = hash_of(e);
+    ENSURE_STATUS(kdw_collider_set_size(e, ball, -0.1f, 0.0f), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_STATUS(kdw_collider_set_size(e, ball, NAN, 0.0f), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_STATUS(kdw_collider_set_size(e, ball, 0.1f, INFINITY), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_STATUS(kdw_collider_set_size(e, ball, 2e6f, 0.0f), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_STATUS(kdw_collider_set_size(e, 0, 0.1f, 0.0f), KDW_STATUS_INVALID_ID);
+    ENSURE_STATUS(kdw_collider_set_size(e, chain, 0.1f, 0.0f), KDW_STATUS_INVALID_ID);
+    ENSURE_STATUS(kdw_collider_set_size(NULL, ball, 0.1f, 0.0f), KDW_STATUS_NULL_POINTER);
+    ENSURE(hash_of(e) == hash);
+
+    ENSURE_OK(kdw_collider_set_size(e, ball, 0.15f, 0.0f));
+    ENSURE(hash_of(e) != hash);
+    for (int frame = 0; frame < 120; ++frame) {
+        ENSURE_OK(kdw_engine_step(e, FRAME_DT, &camera, &anchor));
+        ENSURE(closest_joint(e, chain, centre, &large) == 0);
+        if (frame >= 10) ENSURE(large >= 0.15 - 1e-4); /* pushed out, then kept out */
+    }
+    ENSURE(large < 0.15 + 5e-3);
+    printf("    ball radius 0.10 -> 0.15 m: closest joint %.4f -> %.4f m from its centre\n", small, large);
+
+    /* Shape-specific rules as at creation: a capsule needs a size, inside shapes a radius. */
+    kdw_collider_def capsule_def = collider_at(KDW_COLLIDER_CAPSULE, 0.05f, 0.1f, v3(5.0f, 0.0f, 0.0f));
+    kdw_collider_def hood_def = collider_at(KDW_COLLIDER_INSIDE_SPHERE, 0.5f, 0.0f, v3(0.0f, 1.0f, 0.0f));
+    hood_def.layers = 0x4u;
+    kdw_collider_id capsule = 0, hood = 0;
+    ENSURE_OK(kdw_collider_create(e, &capsule_def, &capsule));
+    ENSURE_OK(kdw_collider_create(e, &hood_def, &hood));
+    const uint64_t before = hash_of(e);
+    ENSURE_STATUS(kdw_collider_set_size(e, capsule, 0.0f, 0.0f), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE_STATUS(kdw_collider_set_size(e, hood, 0.0f, 0.0f), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE(hash_of(e) == before);
+    ENSURE_OK(kdw_collider_set_size(e, capsule, 0.0f, 0.2f)); /* a segment */
+    ENSURE_OK(kdw_collider_set_size(e, hood, 0.6f, 0.0f));
+    ENSURE_OK(kdw_collider_destroy(e, capsule));
+    ENSURE_STATUS(kdw_collider_set_size(e, capsule, 0.05f, 0.1f), KDW_STATUS_INVALID_ID);
+    return 0;
+}
+
 /* ---- error paths ---------------------------------------------------------------------------------------- */
 
 static int test_error_null_engine(void)
@@ -2408,6 +2666,10 @@ int main(void)
     RUN_TEST(test_engine_teleport_carries_chains);
     RUN_TEST(test_teleport_mode_reset);
     RUN_TEST(test_engine_scale);
+    RUN_TEST(test_chain_enabled);
+    RUN_TEST(test_chain_sleeps);
+    RUN_TEST(test_engines_step);
+    RUN_TEST(test_collider_set_size);
     RUN_TEST(test_error_null_engine);
     RUN_TEST(test_error_null_out_pointers);
     RUN_TEST(test_error_null_inputs);

@@ -10,6 +10,8 @@ void discard_everything(kodawari::Engine& engine, kodawari::ViewDependentPhysica
     engine.stateHash();                      // DISCARD
     chain.jointCount();                      // DISCARD
     chain.isValid();                         // DISCARD
+    chain.isEnabled();                       // DISCARD
+    chain.isAsleep();                        // DISCARD
     kodawari::Engine::create();              // DISCARD
 #ifdef KODAWARI_NO_EXCEPTIONS
     engine.step(0.0f, {}, {});               // DISCARD
@@ -20,6 +22,9 @@ void discard_everything(kodawari::Engine& engine, kodawari::ViewDependentPhysica
     engine.setColliderTransforms(nullptr, 0);  // DISCARD
     chain.teleport();                        // DISCARD
     collider.destroy();                      // DISCARD
+    collider.setSize(0.1f, 0.0f);            // DISCARD
+    chain.setEnabled(false);                 // DISCARD
+    kodawari::stepEngines(nullptr, 0, 0.0f, {}, nullptr);  // DISCARD
 #else
     (void)shape;
 #endif

@@ -117,6 +117,40 @@ void test_no_exceptions_scene() {
     CHECK(engine.colliderCount().valueOr(9) == 0);
 }
 
+// Culling, sleeping state, collider resizing and batch stepping return results too.
+void test_no_exceptions_culling_and_batches() {
+    const harness::Scene scene = harness::ahoge_scene();
+    Engine first = Engine::create().value();
+    Engine second = Engine::create().value();
+    const Result<ViewDependentPhysicalObject> chain = first.createChain(ChainDef(), scene.base);
+    CHECK(chain.ok() && second.createChain(ChainDef(), scene.base).ok());
+    static_assert(std::is_same_v<decltype(chain.value().isEnabled()), Result<bool>>);
+    static_assert(std::is_same_v<decltype(kodawari::stepEngines(nullptr, 0, 0.0f, {}, nullptr)), Status>);
+    CHECK(chain.value().isEnabled().value() && !chain.value().isAsleep().value());
+    CHECK(chain.value().setEnabled(false).ok() && !chain.value().isEnabled().value());
+
+    std::vector<Engine*> both{&first, &second};
+    const std::vector<kodawari::Transform> heads(2, scene.head);
+    CHECK(kodawari::stepEngines(both, harness::kDt, harness::orbit_camera(0), heads).ok());
+    CHECK(first.stats().value().chains_asleep == 1 && second.stats().value().chains_asleep == 0);
+    const uint64_t before = first.stateHash().value();
+    both[1] = &first;
+    CHECK_FAILS(kodawari::stepEngines(both, harness::kDt, harness::orbit_camera(1), heads), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK_FAILS(kodawari::stepEngines(both, harness::kDt, harness::orbit_camera(1), kodawari::Span<const kodawari::Transform>()),
+                KDW_STATUS_INVALID_ARGUMENT);
+    CHECK(first.stateHash().value() == before);
+
+    const Result<kodawari::Collider> ball = first.createCollider(kodawari::ColliderDef());
+    CHECK(ball.ok() && ball.value().setSize(0.2f, 0.0f).ok());
+    CHECK_FAILS(ball.value().setSize(-1.0f, 0.0f), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK(chain.value().destroy().ok());
+    CHECK_FAILS(chain.value().setEnabled(true), KDW_STATUS_INVALID_ID);
+    CHECK_FAILS(chain.value().isAsleep(), KDW_STATUS_INVALID_ID);
+}
+
 }  // namespace
 
-void run_no_exception_tests() { harness::run("test_no_exceptions_scene (-fno-exceptions)", test_no_exceptions_scene); }
+void run_no_exception_tests() {
+    harness::run("test_no_exceptions_scene (-fno-exceptions)", test_no_exceptions_scene);
+    harness::run("test_no_exceptions_culling_and_batches (-fno-exceptions)", test_no_exceptions_culling_and_batches);
+}

@@ -33,6 +33,11 @@ static unsafe class Tests
         Run("colliders_keep_the_chain_out", ColliderTests.CollidersKeepTheChainOut);
         Run("collider_update_allocates_nothing", ColliderTests.ColliderUpdateAllocatesNothing);
         Run("teleports_and_scale", ColliderTests.TeleportsAndScale);
+        Run("disabled_chain_rides_with_its_anchor", CullingTests.DisabledChainRidesWithItsAnchor);
+        Run("settled_chain_sleeps_and_lod", CullingTests.SettledChainSleepsAndLod);
+        Run("step_many_equals_single_steps", CullingTests.StepManyEqualsSingleSteps);
+        Run("collider_set_size_pushes_the_chain_out", CullingTests.ColliderSetSizePushesTheChainOut);
+        Run("batch_and_culling_allocate_nothing", CullingTests.BatchAndCullingAllocateNothing);
         Run("readme_snippet", ReadmeSnippet.Run);
         Console.WriteLine(passed + " passed, " + failed + " failed");
         return failed;

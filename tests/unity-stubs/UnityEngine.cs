@@ -42,6 +42,8 @@ namespace UnityEngine
     {
         public Transform transform { get { throw null; } }
         public int layer { get { throw null; } set { } }
+        public bool activeSelf { get { throw null; } }
+        public bool activeInHierarchy { get { throw null; } }
         public T GetComponent<T>() { throw null; }
         public T AddComponent<T>() where T : Component { throw null; }
     }
@@ -238,6 +240,7 @@ namespace UnityEngine
         public static int Max(int a, int b) { throw null; }
         public static float Min(float a, float b) { throw null; }
         public static float Clamp(float value, float min, float max) { throw null; }
+        public static int Clamp(int value, int min, int max) { throw null; }
         public static float Clamp01(float value) { throw null; }
         public static float Abs(float f) { throw null; }
         public static float Pow(float f, float p) { throw null; }

@@ -48,6 +48,14 @@ namespace Kodawari
         /// <summary>Moves the collider to other layers: it affects chains whose collision mask shares a bit.</summary>
         public unsafe void SetLayers(uint layers) { Library.Check(NativeMethods.kdw_collider_set_layers(Ptr, id, layers)); }
 
+        /// <summary>Resizes the collider, keeping its shape: <paramref name="radius"/> and <paramref name="halfHeight"/> in
+        /// world units, validated as in <see cref="ColliderDef"/> (e.g. when the bone it follows is scaled). Wakes sleeping
+        /// chains.</summary>
+        public unsafe void SetSize(float radius, float halfHeight)
+        {
+            Library.Check(NativeMethods.kdw_collider_set_size(Ptr, id, radius, halfHeight));
+        }
+
         /// <summary>Destroys the collider; later colliders keep their relative order.</summary>
         public unsafe void Destroy() { Library.Check(NativeMethods.kdw_collider_destroy(Ptr, id)); }
 

@@ -97,6 +97,26 @@ namespace Kodawari
             set { Library.Check(NativeMethods.kdw_engine_set_gravity(Ptr, (kdw_vec3*)&value)); }
         }
 
+        /// <summary>The level of detail (<see cref="EngineDef.Lod"/>, 0 to 3), read and written through the engine's
+        /// settings without allocating: e.g. set per character by its distance to the camera. Setting it wakes every
+        /// chain; set it only when it changes.</summary>
+        public int Lod
+        {
+            get
+            {
+                kdw_engine_def raw;
+                Library.Check(NativeMethods.kdw_engine_get_def(Ptr, &raw));
+                return (int)raw.lod;
+            }
+            set
+            {
+                kdw_engine_def raw;
+                Library.Check(NativeMethods.kdw_engine_get_def(Ptr, &raw));
+                raw.lod = unchecked((uint)value);
+                Library.Check(NativeMethods.kdw_engine_set_def(Ptr, &raw));
+            }
+        }
+
         // ---- chains ----
 
         /// <summary>Creates a chain from its base shape: at least 2 joints in the anchor frame, root first.</summary>
@@ -289,6 +309,43 @@ namespace Kodawari
             Library.Check(NativeMethods.kdw_engine_step_and_read(Ptr, dt, (kdw_vec3*)&cameraPosition, (kdw_transform*)&viewReference,
                 (kdw_transform*)anchors, Count(anchorCount), (kdw_quat*)localRotations, Count(capacity), &written));
             return (int)written;
+        }
+
+        // Handle scratch of StepMany beyond StackHandles engines: grown once per thread, then reused.
+        [ThreadStatic] static IntPtr[] manyHandles;
+        const int StackHandles = 64;
+
+        /// <summary>Steps several distinct engines by <paramref name="dt"/> with one camera, <c>engines[i]</c> with its view
+        /// reference <c>viewReferences[i]</c> (as <see cref="Step(float, Vec3, JointTransform)"/> each), in ONE native
+        /// call: in parallel when the native library is built with its <c>parallel</c> feature. Every handle and input
+        /// is checked before any engine moves: a null entry (<see cref="KodawariStatus.NullPointer"/>), an engine given
+        /// twice or a bad input (<see cref="KodawariStatus.InvalidArgument"/>) fails the whole call and changes nothing.
+        /// The two spans must have the same length (an <c>Engine[]</c> and a <c>JointTransform[]</c> convert). No
+        /// managed allocation (beyond 64 engines, once per thread).</summary>
+        public static void StepMany(ReadOnlySpan<Engine> engines, float dt, Vec3 cameraPosition,
+                                    ReadOnlySpan<JointTransform> viewReferences)
+        {
+            if (engines.Length != viewReferences.Length)
+                throw new KodawariException(KodawariStatus.InvalidArgument,
+                    "StepMany: " + engines.Length + " engines but " + viewReferences.Length + " view references");
+            int count = engines.Length;
+            IntPtr* stack = stackalloc IntPtr[StackHandles];
+            IntPtr[] heap = null;
+            if (count > StackHandles)
+            {
+                heap = manyHandles;
+                if (heap == null || heap.Length < count) manyHandles = heap = new IntPtr[count];
+            }
+            fixed (IntPtr* pinned = heap)
+            fixed (JointTransform* references = &MemoryMarshal.GetReference(viewReferences))
+            {
+                IntPtr* handles = heap != null ? pinned : stack;
+                for (int i = 0; i < count; i++)
+                    handles[i] = engines[i] != null ? (IntPtr)engines[i].Ptr : IntPtr.Zero;
+                JointTransform noReference;
+                Library.Check(NativeMethods.kdw_engines_step((kdw_engine**)handles, (uint)count, dt, (kdw_vec3*)&cameraPosition,
+                    (kdw_transform*)(references != null ? references : &noReference)));
+            }
         }
 
         // ---- state ----

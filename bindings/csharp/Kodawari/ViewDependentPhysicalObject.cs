@@ -91,6 +91,31 @@ namespace Kodawari
         /// <see cref="EngineDef.TeleportMode"/>), however small.</summary>
         public unsafe void Teleport() { Library.Check(NativeMethods.kdw_chain_teleport(Ptr, id)); }
 
+        /// <summary>Whether the chain is simulated (default true). A disabled (culled) chain costs nothing: it rides
+        /// rigidly with its anchor in its last pose, and enabled again carries on from there.</summary>
+        public unsafe bool Enabled
+        {
+            get
+            {
+                uint enabled = 0;
+                Library.Check(NativeMethods.kdw_chain_is_enabled(Ptr, id, &enabled));
+                return enabled != 0;
+            }
+            set { Library.Check(NativeMethods.kdw_chain_set_enabled(Ptr, id, value ? 1u : 0u)); }
+        }
+
+        /// <summary>True if the chain slept through the last step: its anchor, rest shape and nearby colliders were still
+        /// and its motion had died out (<see cref="EngineDef.SleepSpeed"/>).</summary>
+        public unsafe bool IsAsleep
+        {
+            get
+            {
+                uint asleep = 0;
+                Library.Check(NativeMethods.kdw_chain_is_asleep(Ptr, id, &asleep));
+                return asleep != 0;
+            }
+        }
+
         /// <summary>Per-joint collision radii in character units (x the engine's scale m), each in [0, 1e6]: one per joint,
         /// or none (an empty span) to go back to <see cref="ChainDef.Radius"/> for every joint.</summary>
         public unsafe void SetJointRadii(ReadOnlySpan<float> radii)

@@ -5,8 +5,8 @@ namespace Kodawari.Unity
 {
     /// <summary>A kodawari collider attached to a bone, described the way Unity's <c>SphereCollider</c> and
     /// <c>CapsuleCollider</c> are (a centre and sizes in the bone's local space, a capsule axis). The
-    /// <see cref="Engine"/> creates it when it builds and moves it with the bone every frame. Sizes are taken once,
-    /// at creation, multiplied by the bone's largest lossy scale component.</summary>
+    /// <see cref="Engine"/> creates it when it builds and moves it with the bone every frame. Sizes are multiplied by the
+    /// bone's largest lossy scale component, and follow it when the bone's scale changes.</summary>
     [Serializable]
     public class BoneCollider
     {
@@ -80,6 +80,22 @@ namespace Kodawari.Unity
                 Layers = unchecked((uint)layers),
             };
             return def;
+        }
+
+        /// <summary>The world radius and half height for a bone of lossy scale <paramref name="lossy"/> (as
+        /// <see cref="CreateDef"/>); false when the native engine would reject them (not finite, an inside shape without
+        /// a radius, a capsule of size 0), so the collider keeps its last size. Allocation-free.</summary>
+        public bool SizeAt(Vector3 lossy, out float worldRadius, out float worldHalfHeight)
+        {
+            float scale = Mathf.Max(Mathf.Abs(lossy.x), Mathf.Max(Mathf.Abs(lossy.y), Mathf.Abs(lossy.z)));
+            worldRadius = Mathf.Max(radius, 0f) * scale;
+            worldHalfHeight = Mathf.Max(0f, 0.5f * height - radius) * scale;
+            if (float.IsNaN(worldRadius) || float.IsInfinity(worldRadius) || float.IsNaN(worldHalfHeight)
+                || float.IsInfinity(worldHalfHeight) || worldRadius > 1e6f || worldHalfHeight > 1e6f)
+                return false;
+            if ((shape == ColliderShape.InsideSphere || shape == ColliderShape.InsideCapsule) && worldRadius <= 0f) return false;
+            if (shape == ColliderShape.Capsule && worldRadius <= 0f && worldHalfHeight <= 0f) return false;
+            return true;
         }
 
         /// <summary>The collider's world pose: the bone's transform of <see cref="center"/>, rotated so that the

@@ -10,7 +10,8 @@ namespace Kodawari.Unity
     /// character's bones (<see cref="autoCollectBoneColliders"/>). Every LateUpdate (after animation) it moves
     /// every collider with its bone in one native call, pushes the chains' anchors, runs one native step with the
     /// camera and the view reference bone, and writes every joint's localRotation. No managed allocation per
-    /// frame.</summary>
+    /// frame. Disabling a chain component culls its chain without a rebuild; <see cref="LOD"/> lowers the step rate
+    /// of a distant character without a rebuild; bone colliders follow their bones' scale.</summary>
     [DisallowMultipleComponent]
     [DefaultExecutionOrder(10000)]
     [AddComponentMenu("Kodawari/Engine")]
@@ -22,7 +23,8 @@ namespace Kodawari.Unity
         [Tooltip("The bone view directions are measured from (usually the head). Empty: this transform.")]
         public Transform viewReference;
 
-        [Tooltip("Chains to simulate. Empty: every ViewDependentPhysicalObject below this object, gathered on enable.")]
+        [Tooltip("Chains to simulate. Empty: every ViewDependentPhysicalObject below this object, gathered on enable. "
+                 + "A chain whose component is disabled is created culled and simulated once enabled.")]
         public List<ViewDependentPhysicalObject> chains = new List<ViewDependentPhysicalObject>();
 
         [Header("Solver")]
@@ -44,6 +46,14 @@ namespace Kodawari.Unity
         [Tooltip("Size of the character relative to the units the chains' parameters are tuned in: multiplies gravity, "
                  + "the teleport distance and the chains' radii (a character scaled by 100 with scale 100 moves like the original).")]
         public float scale = 1f;
+
+        [Tooltip("Chains moving slower than this (m/s, relative to their root) for 0.5 s under a still anchor fall asleep "
+                 + "and cost almost nothing until something moves. 0: never sleep.")]
+        public float sleepSpeed = 5e-6f;
+
+        [Tooltip("Level of detail: each level halves the internal step rate (not below 30 Hz) and the iterations (not "
+                 + "below 1). Scripts set LOD by the character's distance to the camera.")]
+        [Range(0, 3)] public int lod = 0;
 
         [Header("Colliders")]
         [Tooltip("Colliders on the character's bones (head, shoulders, body) that keep the chains out.")]
@@ -77,13 +87,46 @@ namespace Kodawari.Unity
         Quat[] localRotations = new Quat[0];
         readonly List<BoneCollider> collectedColliders = new List<BoneCollider>(); // autoCollectBoneColliders, at Start
         readonly List<BoneCollider> activeColliders = new List<BoneCollider>();    // native creation order
+        readonly List<Kodawari.Collider> colliderHandles = new List<Kodawari.Collider>(); // one per active collider
+        readonly List<Vector3> colliderScales = new List<Vector3>(); // each bone's lossy scale its size was set for
         JointTransform[] colliderPoses = new JointTransform[0];                    // one per active collider, reused
+        int[] jointStarts = new int[1];   // chain i's joints are jointTransforms[jointStarts[i] .. jointStarts[i + 1])
+        bool[] chainEnabled = new bool[0]; // mirrors each chain component's enabled state (culled chains are not written)
+        int appliedLod;
         bool started;
         bool settingsChanged;
         Vector3 lastRootPosition;
 
         /// <summary>The native engine while enabled (null otherwise), for advanced use.</summary>
         public Kodawari.Engine Native { get { return native; } }
+
+        /// <summary>The level of detail, 0 to 3 (<see cref="lod"/>): set it per character from its distance to the camera.
+        /// Applied to the running engine at once through its settings (no rebuild, no allocation); setting the current
+        /// value costs nothing.</summary>
+        public int LOD
+        {
+            get { return lod; }
+            set
+            {
+                lod = Mathf.Clamp(value, 0, 3);
+                if (native != null && lod != appliedLod)
+                {
+                    native.Lod = lod;
+                    appliedLod = lod;
+                }
+            }
+        }
+
+        /// <summary>Culls (false) or resumes (true) <paramref name="chain"/>'s simulation; called by the chain component's
+        /// OnDisable and OnEnable. A culled chain rides rigidly with its anchor and its joints are not written.</summary>
+        internal void SetChainEnabled(ViewDependentPhysicalObject chain, bool value)
+        {
+            if (native == null) return;
+            int index = Array.IndexOf(active, chain);
+            if (index < 0 || chainEnabled[index] == value) return;
+            chainHandles[index].Enabled = value;
+            chainEnabled[index] = value;
+        }
 
         void OnEnable()
         {
@@ -138,7 +181,8 @@ namespace Kodawari.Unity
                     Debug.LogWarning("Kodawari: a collider without a bone was skipped.", this);
                     continue;
                 }
-                native.CreateCollider(entry.CreateDef());
+                colliderHandles.Add(native.CreateCollider(entry.CreateDef()));
+                colliderScales.Add(entry.bone.lossyScale);
                 activeColliders.Add(entry);
             }
             colliderPoses = new JointTransform[activeColliders.Count]; // setup only, reused every frame
@@ -183,6 +227,8 @@ namespace Kodawari.Unity
                 TeleportAngle = Mathf.Max(teleportAngle, 0.01f) * Mathf.Deg2Rad,
                 TeleportMode = teleportMode,
                 Scale = Mathf.Clamp(scale, 1e-6f, 1e6f),
+                SleepSpeed = Mathf.Max(sleepSpeed, 0f),
+                Lod = Mathf.Clamp(lod, 0, 3),
             };
         }
 
@@ -192,7 +238,7 @@ namespace Kodawari.Unity
             if (chains != null && chains.Count > 0)
             {
                 foreach (var chain in chains)
-                    if (chain != null && chain.isActiveAndEnabled) found.Add(chain);
+                    if (chain != null && chain.gameObject.activeInHierarchy) found.Add(chain);
             }
             else
             {
@@ -200,11 +246,14 @@ namespace Kodawari.Unity
             }
 
             native = new Kodawari.Engine(CreateDef());
+            appliedLod = Mathf.Clamp(lod, 0, 3);
             var jointList = new List<Transform>();
             var anchorList = new List<Transform>();
             var activeList = new List<ViewDependentPhysicalObject>();
             var handleList = new List<Kodawari.ViewDependentPhysicalObject>();
             var viewHandleList = new List<ViewShape[]>();
+            var startList = new List<int> { 0 };
+            var enabledList = new List<bool>();
             Transform reference = ViewReference;
             foreach (var chain in found)
             {
@@ -218,6 +267,7 @@ namespace Kodawari.Unity
                 var shape = new JointTransform[joints.Count];
                 for (int i = 0; i < joints.Count; i++) shape[i] = joints[i].PoseIn(anchor);
                 Kodawari.ViewDependentPhysicalObject handle = native.CreateChain(chain.CreateDef(), shape);
+                if (!chain.enabled) handle.Enabled = false; // culled until its component is enabled
                 var viewHandles = new ViewShape[chain.viewShapes.Count];
                 for (int v = 0; v < chain.viewShapes.Count; v++)
                 {
@@ -238,15 +288,22 @@ namespace Kodawari.Unity
                 activeList.Add(chain);
                 anchorList.Add(anchor);
                 jointList.AddRange(joints);
+                startList.Add(jointList.Count);
+                enabledList.Add(chain.enabled);
+                chain.owner = this;
             }
             active = activeList.ToArray();
             chainHandles = handleList.ToArray();
             viewShapeHandles = viewHandleList.ToArray();
             anchorTransforms = anchorList.ToArray();
             jointTransforms = jointList.ToArray();
+            jointStarts = startList.ToArray();
+            chainEnabled = enabledList.ToArray();
             anchors = new JointTransform[anchorTransforms.Length];
             localRotations = new Quat[jointTransforms.Length];
             activeColliders.Clear();
+            colliderHandles.Clear();
+            colliderScales.Clear();
             CreateColliders(colliders);
             if (started) CreateColliders(collectedColliders);
             settingsChanged = false;
@@ -258,7 +315,11 @@ namespace Kodawari.Unity
         {
             if (native != null) native.Dispose();
             native = null;
+            foreach (var chain in active)
+                if (chain != null && chain.owner == this) chain.owner = null;
             activeColliders.Clear();
+            colliderHandles.Clear();
+            colliderScales.Clear();
         }
 
         bool AnyChainChanged()
@@ -278,10 +339,18 @@ namespace Kodawari.Unity
             // Anchors: each chain root's parent.
             for (int i = 0; i < anchorTransforms.Length; i++) anchors[i] = anchorTransforms[i].WorldPose();
 
-            // Colliders follow their bones: every pose in one native call, from the preallocated array.
+            // Colliders follow their bones: every pose in one native call, from the preallocated array; a bone whose
+            // lossy scale changed resizes its collider (one compare per collider, a native call only on change).
             if (colliderPoses.Length > 0)
             {
-                for (int i = 0; i < colliderPoses.Length; i++) colliderPoses[i] = activeColliders[i].WorldPose();
+                for (int i = 0; i < colliderPoses.Length; i++)
+                {
+                    BoneCollider entry = activeColliders[i];
+                    colliderPoses[i] = entry.WorldPose();
+                    Vector3 lossy = entry.bone.lossyScale;
+                    Vector3 last = colliderScales[i];
+                    if (lossy.x != last.x || lossy.y != last.y || lossy.z != last.z) ResizeCollider(i, lossy);
+                }
                 native.SetColliderTransforms(colliderPoses);
             }
 
@@ -294,7 +363,22 @@ namespace Kodawari.Unity
             Vec3 cameraPosition = view != null ? view.transform.position.ToKodawari() : reference.position.ToKodawari();
             // One native call per frame: anchors in, step, local rotations out.
             native.StepAndReadLocalRotations(Time.deltaTime, cameraPosition, reference.WorldPose(), anchors, localRotations);
-            for (int i = 0; i < jointTransforms.Length; i++) jointTransforms[i].localRotation = localRotations[i].ToUnity();
+            // Culled chains (component disabled) are not written: their bones are left to the animation.
+            for (int c = 0; c < chainEnabled.Length; c++)
+            {
+                if (!chainEnabled[c]) continue;
+                for (int i = jointStarts[c]; i < jointStarts[c + 1]; i++) jointTransforms[i].localRotation = localRotations[i].ToUnity();
+            }
+        }
+
+        void ResizeCollider(int index, Vector3 lossy)
+        {
+            float radius, halfHeight;
+            if (activeColliders[index].SizeAt(lossy, out radius, out halfHeight))
+            {
+                colliderHandles[index].SetSize(radius, halfHeight);
+                colliderScales[index] = lossy;
+            }
         }
 
         void ApplySettings()
@@ -303,6 +387,9 @@ namespace Kodawari.Unity
             {
                 settingsChanged = false;
                 native.Def = CreateDef();
+                appliedLod = Mathf.Clamp(lod, 0, 3);
+                // Sizes edited in the inspector: re-upload every collider's size at its bone's current scale.
+                for (int i = 0; i < colliderScales.Count; i++) ResizeCollider(i, activeColliders[i].bone.lossyScale);
             }
             // Per-chain edits (inspector sliders, MarkSettingsChanged): parameters and view shape influences.
             for (int i = 0; i < active.Length; i++)

@@ -24,7 +24,9 @@ namespace Kodawari.Unity
     }
 
     /// <summary>A physical joint chain (hair strand, ear, ribbon, tail) simulated by the <see cref="Engine"/> on an
-    /// ancestor. Put it on the chain's root joint; its parent is the chain's anchor.</summary>
+    /// ancestor. Put it on the chain's root joint; its parent is the chain's anchor. Disabling the component at run
+    /// time culls the chain (<c>kdw_chain_set_enabled</c>): it is no longer simulated nor written, costs nothing, and
+    /// enabled again carries on from its last pose; nothing is rebuilt.</summary>
     [DisallowMultipleComponent]
     [AddComponentMenu("Kodawari/View Dependent Physical Object")]
     public sealed class ViewDependentPhysicalObject : MonoBehaviour
@@ -66,6 +68,17 @@ namespace Kodawari.Unity
         public List<ViewShapeData> viewShapes = new List<ViewShapeData>();
 
         [NonSerialized] internal bool parametersChanged;
+        [NonSerialized] internal Engine owner; // the Engine simulating this chain while it runs, else null
+
+        void OnEnable()
+        {
+            if (owner != null) owner.SetChainEnabled(this, true);
+        }
+
+        void OnDisable()
+        {
+            if (owner != null) owner.SetChainEnabled(this, false);
+        }
 
         /// <summary>The anchor: the root joint's parent (the bone the chain hangs from).</summary>
         public Transform Anchor { get { return Root.parent; } }

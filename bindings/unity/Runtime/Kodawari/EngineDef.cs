@@ -47,6 +47,15 @@ namespace Kodawari
         /// <summary>What a teleport does to a chain. Default <see cref="Kodawari.TeleportMode.CarryShape"/>.</summary>
         public TeleportMode TeleportMode { get { return (TeleportMode)Raw.teleport_mode; } set { Raw.teleport_mode = (uint)value; } }
 
+        /// <summary>A chain whose joints all move slower than this relative to its root (character units/s, x
+        /// <see cref="Scale"/>) for 0.5 s, under a still anchor, rest shape and nearby colliders, sleeps (costs almost
+        /// nothing) until one of them changes. In [0, 1e6]; 0 never sleeps. Default 5e-6.</summary>
+        public float SleepSpeed { get { return Raw.sleep_speed; } set { Raw.sleep_speed = value; } }
+
+        /// <summary>Level of detail for distant characters, in [0, 3]: each level halves the internal step rate (not
+        /// below 30 Hz) and the iterations (not below 1). Default 0.</summary>
+        public int Lod { get { return (int)Raw.lod; } set { Raw.lod = unchecked((uint)value); } }
+
         /// <summary>Size of the character relative to the units its parameters are tuned in, in [1e-6, 1e6]: multiplies
         /// gravity, the teleport distance and chain/joint radii (a character scaled by 100 with scale 100 moves like the
         /// unscaled one). Transforms and collider sizes stay world units. Default 1.</summary>

@@ -133,7 +133,37 @@ fn a_frame_allocates_nothing() {
         c_frame(n);
     }
     let c_allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
-    assert_eq!(kdw_engine_destroy(handle), 0);
-    println!("allocations over 300 frames: Rust API {rust_allocations}, C ABI {c_allocations}");
-    assert_eq!((rust_allocations, c_allocations), (0, 0));
+
+    // Several engines in one batch call (serial build; the thread pool's own bookkeeping is rayon's).
+    let handles: Vec<*mut kdw_engine> = (0..4)
+        .map(|_| {
+            let mut e = std::ptr::null_mut();
+            assert_eq!(kdw_engine_create(&kdw_engine_def_default(), &mut e), 0);
+            let mut id = 0;
+            assert_eq!(kodawari::ffi::chain::kdw_chain_create(e, &def, joints_c.as_ptr(), 8, &mut id), 0);
+            e
+        })
+        .collect();
+    let references = [k; 4];
+    let batch_frame = |n: usize| {
+        let camera: kdw_vec3 = orbit_camera(HEAD, 3.0, n as f32 * 0.05).into();
+        let status =
+            kodawari::ffi::batch::kdw_engines_step(handles.as_ptr(), 4, 1.0 / 60.0, &camera, references.as_ptr());
+        assert_eq!(status, 0);
+    };
+    for n in 0..30 {
+        batch_frame(n);
+    }
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    for n in 30..330 {
+        batch_frame(n);
+    }
+    let batch_allocations = if cfg!(feature = "parallel") { 0 } else { ALLOCATIONS.load(Ordering::Relaxed) - before };
+    for e in handles.into_iter().chain([handle]) {
+        assert_eq!(kdw_engine_destroy(e), 0);
+    }
+    println!(
+        "allocations over 300 frames: Rust API {rust_allocations}, C ABI {c_allocations}, batch call {batch_allocations}"
+    );
+    assert_eq!((rust_allocations, c_allocations, batch_allocations), (0, 0, 0));
 }

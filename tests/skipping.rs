@@ -109,34 +109,46 @@ fn any_change_wakes_a_sleeping_chain() {
 }
 
 /// A disabled chain is not simulated (counted as idle), follows its anchor rigidly, and enabled again
-/// carries on without a whip.
+/// carries on from its frozen state without a whip, in either teleport mode: after re-enabling, its pose
+/// relative to the anchor is what it is for a chain whose character stood still meanwhile.
 #[test]
 fn disabled_chain_costs_nothing_and_follows_its_anchor() {
-    let mut engine = engine_with(EngineSettings::default());
     let base = straight_chain(8, Vec3::ZERO, Vec3::X, 0.05);
-    let id = engine.create_chain(limp(), &base).unwrap();
-    settle(&mut engine, 0.3);
-    engine.set_chain_enabled(id, false).unwrap();
-    engine.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
-    let frozen: Vec<Vec3> = chain_world(&engine, id).iter().map(|t| t.position - HEAD).collect();
-    let substeps_before = engine.stats().substeps_total;
-    let moved = HEAD + Vec3::new(2.0, 0.5, 0.0);
-    for _ in 0..30 {
+    let run = |mode: kodawari::TeleportMode, travel: Vec3| {
+        let mut engine = engine_with(EngineSettings { teleport_mode: mode, ..Default::default() });
+        let id = engine.create_chain(limp(), &base).unwrap();
+        settle(&mut engine, 0.3);
+        engine.set_chain_enabled(id, false).unwrap();
+        engine.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
+        let frozen: Vec<Vec3> = chain_world(&engine, id).iter().map(|t| t.position - HEAD).collect();
+        let substeps_before = engine.stats().substeps_total;
+        let moved = HEAD + travel;
+        for _ in 0..30 {
+            engine.step(1.0 / 60.0, moved + Vec3::Z * 5.0, at(moved)).unwrap();
+        }
+        assert_eq!(engine.stats().chains_asleep, 1);
+        assert!(engine.stats().substeps_total > substeps_before, "the clock still runs");
+        let riding: Vec<Vec3> = chain_world(&engine, id).iter().map(|t| t.position - moved).collect();
+        let drift = frozen.iter().zip(&riding).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+        assert!(drift <= 1e-6, "a disabled chain moves rigidly with its anchor: {drift}");
+        engine.set_chain_enabled(id, true).unwrap();
         engine.step(1.0 / 60.0, moved + Vec3::Z * 5.0, at(moved)).unwrap();
+        assert_eq!(engine.stats().chains_asleep, 0);
+        let resumed: Vec<Vec3> = chain_world(&engine, id).iter().map(|t| t.position - moved).collect();
+        (resumed, engine.chain_kinetic_energy(id).unwrap())
+    };
+    for mode in [kodawari::TeleportMode::CarryShape, kodawari::TeleportMode::Reset] {
+        let (stood, energy_stood) = run(mode, Vec3::ZERO);
+        let (travelled, energy_travelled) = run(mode, Vec3::new(2.0, 0.5, 0.0));
+        let difference = stood.iter().zip(&travelled).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+        println!(
+            "{mode:?}: re-enabled after a 2.1 m move vs after standing still: pose {difference:.2e} m, kinetic \
+             energy {energy_travelled:.3} J vs {energy_stood:.3} J"
+        );
+        assert!(difference <= 1e-5, "{mode:?}: {difference}");
+        assert!((energy_travelled - energy_stood).abs() <= 1e-3 * energy_stood, "{mode:?}");
+        assert!(energy_stood > 1.0, "{mode:?}: the chain kept its swing (not reset)");
     }
-    assert_eq!(engine.stats().chains_asleep, 1);
-    let now: Vec<Vec3> = chain_world(&engine, id).iter().map(|t| t.position - moved).collect();
-    let drift = frozen.iter().zip(&now).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
-    assert!(drift <= 1e-6, "a disabled chain moves rigidly with its anchor: {drift}");
-    assert!(engine.stats().substeps_total > substeps_before, "the clock still runs");
-    engine.set_chain_enabled(id, true).unwrap();
-    let energy_before = engine.chain_kinetic_energy(id).unwrap();
-    engine.step(1.0 / 60.0, moved + Vec3::Z * 5.0, at(moved)).unwrap();
-    // Re-enabled: the jump from where it was disabled is carried, so only gravity adds energy.
-    let energy_after = engine.chain_kinetic_energy(id).unwrap();
-    println!("re-enabled after a 2 m move: kinetic energy {energy_before:.3} J -> {energy_after:.3} J");
-    assert!(energy_after < energy_before + 1.0, "{energy_before} -> {energy_after}");
-    assert_eq!(engine.stats().chains_asleep, 0);
 }
 
 /// Each level of detail halves the internal step rate (not below 30 Hz) and the iterations (not below 1).

@@ -192,12 +192,15 @@ pub extern "C" fn kdw_chain_teleport(engine: *mut kdw_engine, chain: kdw_chain_i
 /// follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_chain_set_enabled(engine: *mut kdw_engine, chain: kdw_chain_id, enabled: u32) -> kdw_status {
-    guard(|| {
-        if enabled > 1 {
-            return Err(crate::core::Error::invalid_argument(format!("enabled must be 0 or 1, got {enabled}")).into());
-        }
-        // SAFETY: live engine handle, this thread only.
-        unsafe { with_engine_mut(engine, |e| Ok(e.set_chain_enabled(ChainId::from_bits(chain), enabled == 1)?)) }
+    // SAFETY: live engine handle, this thread only.
+    guard(|| unsafe {
+        with_engine_mut(engine, |e| {
+            if enabled > 1 {
+                let message = format!("enabled must be 0 or 1, got {enabled}");
+                return Err(crate::core::Error::invalid_argument(message).into());
+            }
+            Ok(e.set_chain_enabled(ChainId::from_bits(chain), enabled == 1)?)
+        })
     })
 }
 

@@ -95,13 +95,6 @@ pub(crate) struct EngineBox {
     pub poisoned: bool,
 }
 
-/// Marks engines whose step panicked part way (a batch call cannot tell which one did).
-pub(crate) fn poison_all(boxes: &mut [&mut EngineBox]) {
-    for b in boxes {
-        b.poisoned = true;
-    }
-}
-
 fn poisoned_error() -> FfiError {
     FfiError::new(KDW_STATUS_PANIC, "the engine was poisoned by an earlier internal error; destroy it")
 }
@@ -113,7 +106,7 @@ pub(crate) fn into_handle(engine: Engine) -> *mut kdw_engine {
 /// # Safety
 /// `handle` must be NULL or a pointer from [`into_handle`] not yet destroyed.
 pub(crate) unsafe fn destroy_handle(handle: *mut kdw_engine) -> FfiResult<()> {
-    check_pointer(handle.cast_const(), "engine")?;
+    check_pointer(handle.cast_const().cast::<EngineBox>(), "engine")?;
     // SAFETY: created by `into_handle` (Box::into_raw of an EngineBox) and not destroyed yet.
     drop(unsafe { Box::from_raw(handle.cast::<EngineBox>()) });
     Ok(())
@@ -127,7 +120,7 @@ pub(crate) unsafe fn with_engine<R>(
     handle: *const kdw_engine,
     f: impl FnOnce(&Engine) -> FfiResult<R>,
 ) -> FfiResult<R> {
-    check_pointer(handle, "engine")?;
+    check_pointer(handle.cast::<EngineBox>(), "engine")?;
     // SAFETY: a live EngineBox per the contract; shared access only.
     let boxed = unsafe { &*handle.cast::<EngineBox>() };
     if boxed.poisoned {
@@ -144,7 +137,7 @@ pub(crate) unsafe fn with_engine_mut<R>(
     handle: *mut kdw_engine,
     f: impl FnOnce(&mut Engine) -> FfiResult<R>,
 ) -> FfiResult<R> {
-    check_pointer(handle.cast_const(), "engine")?;
+    check_pointer(handle.cast_const().cast::<EngineBox>(), "engine")?;
     // SAFETY: a live EngineBox per the contract; exclusive for the duration of the call.
     let boxed = unsafe { &mut *handle.cast::<EngineBox>() };
     if boxed.poisoned {

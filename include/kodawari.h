@@ -352,8 +352,11 @@ kdw_status kdw_chain_set_joint_radii(struct kdw_engine *engine,
 kdw_status kdw_chain_teleport(struct kdw_engine *engine, kdw_chain_id chain);
 
 // Enables (1) or disables (0) a chain. A disabled (culled) chain is not simulated and costs nothing; it
-// follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip.
-kdw_status kdw_chain_set_enabled(struct kdw_engine *engine, kdw_chain_id chain, uint32_t enabled);
+// follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip (carried
+// to its current anchor whatever the `teleport_mode`).
+kdw_status kdw_chain_set_enabled(struct kdw_engine *engine,
+                                 kdw_chain_id chain,
+                                 uint32_t enabled);
 
 // `*out_enabled` = 1 if the chain is enabled, else 0.
 kdw_status kdw_chain_is_enabled(const struct kdw_engine *engine, kdw_chain_id chain, uint32_t *out_enabled);

@@ -130,7 +130,8 @@ namespace Kodawari.Native
 
         /// <summary>
         ///  Enables (1) or disables (0) a chain. A disabled (culled) chain is not simulated and costs nothing; it
-        ///  follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip.
+        ///  follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip (carried
+        ///  to its current anchor whatever the `teleport_mode`).
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_chain_set_enabled", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
         internal static extern int kdw_chain_set_enabled(kdw_engine* engine, ulong chain, uint enabled);

@@ -189,7 +189,8 @@ pub extern "C" fn kdw_chain_teleport(engine: *mut kdw_engine, chain: kdw_chain_i
 }
 
 /// Enables (1) or disables (0) a chain. A disabled (culled) chain is not simulated and costs nothing; it
-/// follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip.
+/// follows its anchor rigidly in its last pose, and enabled again carries on from there without a whip (carried
+/// to its current anchor whatever the `teleport_mode`).
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_chain_set_enabled(engine: *mut kdw_engine, chain: kdw_chain_id, enabled: u32) -> kdw_status {
     // SAFETY: live engine handle, this thread only.

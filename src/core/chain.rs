@@ -8,7 +8,7 @@ use super::blend::blend_into;
 use super::error::{Error, Result};
 use super::math::{Transform, direction, nlerp_shorter, swing_to};
 use super::params::ChainParams;
-use super::rod::RodState;
+use super::rod::{RestGroups, RodState};
 use super::shape::{EncodedShape, Shape, ShapeFrame};
 use super::weights::{ViewWeighting, blend_weights};
 
@@ -44,6 +44,11 @@ pub struct Chain {
     /// The rest shape of the last substep; differs from `rest` while `rest_changed`.
     pub(crate) rest_used: Shape,
     pub(crate) rest_changed: bool,
+    /// What the shape-matching groups need of `rest`, rebuilt by [`Chain::refresh_rest_groups`] when stale.
+    pub(crate) rest_groups: RestGroups,
+    rest_groups_stale: bool,
+    /// The shortest of `frame.lengths`.
+    pub(crate) shortest_segment: f32,
     blended_for: Option<Vec3>,
     shapes_dirty: bool,
     pub(crate) state: RodState,
@@ -64,6 +69,9 @@ pub struct Chain {
     pub(crate) teleport_requested: bool,
     /// A disabled (culled) chain is not simulated; it follows its anchor rigidly.
     pub(crate) enabled: bool,
+    /// The anchor (world) the particle state was last simulated under, while the chain is disabled: the next
+    /// step after re-enabling carries the state from there to the current anchor.
+    pub(crate) resume_from: Option<Transform>,
     /// Sleeping: nothing moved for a while; the chain is skipped until something changes.
     pub(crate) asleep: bool,
     /// Simulated seconds the chain has been still (towards falling asleep).
@@ -77,6 +85,7 @@ impl Chain {
         let n = base_shape.len();
         let frame = ShapeFrame::from_base(&base_shape);
         let base = EncodedShape::encode(&base_shape, frame.reference);
+        let shortest_segment = shortest(&frame.lengths);
         let local: Vec<Transform> =
             base_shape.positions.iter().zip(&base_shape.orientations).map(|(p, q)| Transform::new(*p, *q)).collect();
         let mut chain = Self {
@@ -91,6 +100,9 @@ impl Chain {
             rest: base_shape.clone(),
             rest_used: base_shape.clone(),
             rest_changed: false,
+            rest_groups: RestGroups::default(),
+            rest_groups_stale: true,
+            shortest_segment,
             blended_for: None,
             shapes_dirty: true,
             state: RodState::at_rest(&base_shape, &Transform::IDENTITY),
@@ -104,6 +116,7 @@ impl Chain {
             joint_radii: Vec::new(),
             teleport_requested: false,
             enabled: true,
+            resume_from: None,
             asleep: false,
             still_time: 0.0,
         };
@@ -188,6 +201,7 @@ impl Chain {
         }
         self.base = EncodedShape::encode(&shape, frame.reference);
         self.bone_axes = bone_axes(&shape);
+        self.shortest_segment = shortest(&frame.lengths);
         self.frame = frame;
         self.shapes_dirty = true;
         Ok(())
@@ -230,8 +244,18 @@ impl Chain {
                     _ => q,
                 };
         }
+        self.rest_groups_stale = true;
         if self.rest != self.rest_used {
             self.rest_changed = true;
+        }
+    }
+
+    /// Brings `rest_groups` up to date with `rest`; cheap when it is.
+    #[inline]
+    pub(crate) fn refresh_rest_groups(&mut self) {
+        if self.rest_groups_stale {
+            self.rest_groups.rebuild(&self.rest);
+            self.rest_groups_stale = false;
         }
     }
 
@@ -295,6 +319,10 @@ impl Chain {
     pub(crate) fn view_shape_index(&self, id: ViewShapeId) -> Option<usize> {
         self.views.iter().position(|v| v.id == id)
     }
+}
+
+fn shortest(lengths: &[f32]) -> f32 {
+    lengths.iter().copied().fold(f32::INFINITY, f32::min)
 }
 
 fn bone_axes(shape: &Shape) -> Vec<Vec3> {

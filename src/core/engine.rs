@@ -272,11 +272,16 @@ impl Engine {
     }
 
     /// A disabled (culled) chain is not simulated and costs nothing; it follows its anchor rigidly in its last
-    /// pose. Enabled again, it carries on from that pose as after a teleport (no whip).
+    /// pose. Enabled again, it carries on from that pose, carried rigidly to where its anchor is now (no whip,
+    /// in either teleport mode).
     pub fn set_chain_enabled(&mut self, id: ChainId, enabled: bool) -> Result<()> {
         let chain = self.chain_mut(id)?;
-        if enabled && !chain.enabled {
-            chain.teleport_requested = true;
+        if chain.enabled && !enabled {
+            // The state stays where it was simulated last; re-enabled, it is carried (whatever the teleport mode)
+            // from that anchor to the current one by the next step.
+            chain.resume_from = Some(chain.anchor);
+        }
+        if enabled != chain.enabled {
             chain.wake();
         }
         chain.enabled = enabled;
@@ -545,14 +550,18 @@ impl Engine {
                 idle += 1;
                 continue;
             }
+            let resuming = chain.resume_from.take();
+            if let Some(from) = resuming {
+                start = to_relative(&from);
+            }
             let anchor_still = start == target && chain.placed;
             chain.update_rest(self.view);
             let teleport = std::mem::take(&mut chain.teleport_requested)
                 || is_teleport(&start, &target, teleport_distance, settings.teleport_angle);
-            if !chain.placed || (teleport && settings.teleport_mode == TeleportMode::Reset) {
+            if !chain.placed || (teleport && settings.teleport_mode == TeleportMode::Reset && resuming.is_none()) {
                 chain.place(&target);
                 start = target;
-            } else if teleport {
+            } else if teleport || resuming.is_some() {
                 // Carry the chain rigidly: keeps its shape, adds no energy, no whip.
                 chain.state.carry(&target.mul(&start.inverse()));
                 start = target;
@@ -625,6 +634,7 @@ impl Engine {
                     contacts.chain_sweeps.clear();
                     contacts.chain_sweeps.extend(contacts.candidates.iter().map(|&c| row[c]));
                 }
+                chain.refresh_rest_groups();
                 let input = SubstepInput {
                     h: h as f32,
                     anchor,
@@ -632,9 +642,10 @@ impl Engine {
                     velocity_decay: decay,
                     alpha_per_iteration: alpha,
                     iterations,
-                    inv_mass: 1.0 / params.mass,
                     orientation_weight: (params.radius * settings.scale).powi(2) / 5.0,
                     rest: &chain.rest,
+                    rest_groups: &chain.rest_groups,
+                    shortest_segment: chain.shortest_segment,
                     half_kick: chain.half_kick,
                     contacts: touching.then(|| ContactInput {
                         colliders: &contacts.chain_sweeps,

@@ -12,37 +12,66 @@ const MAX_NEWTON_ITERATIONS: usize = 8;
 /// Largest error still accepted as a rounding floor when Newton stops improving.
 const STAGNATION_LIMIT: f64 = 1e-3;
 const FALLBACK_SWEEPS: usize = 64;
+/// A pivot of the Newton system smaller than this share of its largest diagonal entry counts as vanishing.
+const MIN_PIVOT: f64 = 1e-7;
 
-/// Reusable buffers, one entry per bond.
+/// Reusable buffers, one entry per bond unless noted. The dynamic particles' masses are uniform, so they
+/// cancel out of the solve: only the kinematic root's infinite mass (it never moves) shapes it.
 #[derive(Default)]
 pub struct ConstraintScratch {
-    lambda: Vec<f64>,
-    bonds: Vec<DVec3>,
-    directions: Vec<DVec3>,
-    residual: Vec<f64>,
-    diag: Vec<f64>,
+    /// The start positions' bonds, from [`prepare`]: the direct solve's correction directions.
+    start_bonds: Vec<DVec3>,
+    /// The current bonds: the fallback's correction directions.
+    current_bonds: Vec<DVec3>,
+    /// Squared rest lengths and their reciprocals, from [`prepare`].
+    length_squared: Vec<f64>,
+    inverse_length_squared: Vec<f64>,
+    newton: NewtonScratch,
+}
+
+#[derive(Default)]
+struct NewtonScratch {
+    /// Correction multipliers (inverse mass included).
+    mu: Vec<f64>,
+    /// The Thomas algorithm's modified upper diagonal and right-hand side.
     c_prime: Vec<f64>,
     d_prime: Vec<f64>,
+    /// Positions under the current multipliers (one per particle).
+    corrected: Vec<DVec3>,
 }
 
 impl ConstraintScratch {
     pub fn reserve(&mut self, bonds: usize) {
-        for v in [&mut self.lambda, &mut self.residual, &mut self.diag, &mut self.c_prime, &mut self.d_prime] {
+        let NewtonScratch { mu, c_prime, d_prime, corrected } = &mut self.newton;
+        for v in [&mut self.length_squared, &mut self.inverse_length_squared, mu, c_prime, d_prime] {
             if v.len() < bonds {
                 v.resize(bonds, 0.0);
             }
         }
-        if self.bonds.len() < bonds {
-            self.bonds.resize(bonds, DVec3::ZERO);
-            self.directions.resize(bonds, DVec3::ZERO);
+        for v in [&mut self.start_bonds, &mut self.current_bonds] {
+            if v.len() < bonds {
+                v.resize(bonds, DVec3::ZERO);
+            }
+        }
+        if corrected.len() < bonds + 1 {
+            corrected.resize(bonds + 1, DVec3::ZERO);
         }
     }
 }
 
-/// Inverse mass of particle `j`: particle 0 is kinematic.
-#[inline]
-fn inv_mass<T: Default>(j: usize, dynamic_inv_mass: T) -> T {
-    if j == 0 { T::default() } else { dynamic_inv_mass }
+/// Prepares [`solve_prepared`] for the start positions `x` of a substep: their bonds are the correction
+/// directions of every solve until `x` moves (the contact pass can move it; prepare again then).
+pub fn prepare(x: &[DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
+    let m = lengths.len();
+    debug_assert!(x.len() == m + 1);
+    s.reserve(m);
+    for k in 0..m {
+        s.start_bonds[k] = x[k + 1] - x[k];
+        // Exact: a float32 squared fits in a double.
+        let l2 = lengths[k] as f64 * lengths[k] as f64;
+        s.length_squared[k] = l2;
+        s.inverse_length_squared[k] = 1.0 / l2;
+    }
 }
 
 /// Moves `p` so that `|p[k+1] - p[k]| = lengths[k]` for every bond, correcting along the previous
@@ -50,144 +79,164 @@ fn inv_mass<T: Default>(j: usize, dynamic_inv_mass: T) -> T {
 /// (a bond turned by about 90 degrees in one substep, as at the tip of a whipping rope) and the fallback
 /// ran: the same Newton solve along the current bonds (always well conditioned, not symplectic), then, if
 /// even that fails, Gauss-Seidel projection.
-pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f32, s: &mut ConstraintScratch) -> bool {
+pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> bool {
+    prepare(x, lengths, s);
+    solve_prepared(p, lengths, s)
+}
+
+/// [`solve`] with the previous positions given to the last [`prepare`] (with the same `lengths`).
+pub fn solve_prepared(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> bool {
     let m = lengths.len();
-    debug_assert!(x.len() == m + 1 && p.len() == m + 1);
-    s.reserve(m);
-    for k in 0..m {
-        s.directions[k] = x[k + 1] - x[k];
-    }
-    if newton_along_directions(p, lengths, dynamic_inv_mass as f64, s) {
+    debug_assert!(p.len() == m + 1 && s.start_bonds.len() >= m);
+    let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
+    if newton_along_directions(p, &s.start_bonds[..m], l2, inv_l2, &mut s.newton) {
         return true;
     }
     for k in 0..m {
-        s.directions[k] = p[k + 1] - p[k];
+        s.current_bonds[k] = p[k + 1] - p[k];
     }
-    if !newton_along_directions(p, lengths, dynamic_inv_mass as f64, s) {
-        project_gauss_seidel(p, lengths, dynamic_inv_mass);
+    if !newton_along_directions(p, &s.current_bonds[..m], l2, inv_l2, &mut s.newton) {
+        project_gauss_seidel(p, lengths);
     }
     false
 }
 
-/// Newton iterations on the multipliers of corrections along `s.directions` (one per bond); applies them
-/// to `p` and returns `true` when converged, leaves `p` untouched otherwise.
-fn newton_along_directions(p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f64, s: &mut ConstraintScratch) -> bool {
-    let m = lengths.len();
+/// Newton iterations on the multipliers `mu` of corrections along the directions `d` (one per bond):
+/// particle `j` moves by `d[j-1] mu[j-1] - d[j] mu[j]` (the root not at all). Applies them to `p` and returns
+/// `true` when converged, leaves `p` untouched otherwise.
+///
+/// Each iteration is one pass root to tip that evaluates the bonds under the current multipliers and runs
+/// the forward elimination of the Thomas algorithm on the tridiagonal Newton system `J delta = -F/2`
+/// (`F_k = |b_k|^2 - l_k^2`, `J` the halved Jacobian `dF/dmu`), then one pass back. The elimination of the
+/// last, converged pass is wasted, but the fused pass reads every bond once and overlaps the elimination's
+/// chain of divisions with independent work.
+fn newton_along_directions(
+    p: &mut [DVec3],
+    d: &[DVec3],
+    length_squared: &[f64],
+    inverse_length_squared: &[f64],
+    s: &mut NewtonScratch,
+) -> bool {
+    let m = d.len();
     let p = &mut p[..m + 1];
-    let w = |j: usize| inv_mass(j, dynamic_inv_mass);
-    let d = &s.directions[..m];
-    let (lambda, bonds, residual) = (&mut s.lambda[..m], &mut s.bonds[..m], &mut s.residual[..m]);
-    let (diag, c_prime, d_prime) = (&mut s.diag[..m], &mut s.c_prime[..m], &mut s.d_prime[..m]);
-    lambda.fill(0.0);
-    let mut converged = false;
+    let (l2, inv_l2) = (&length_squared[..m], &inverse_length_squared[..m]);
+    let (mu, corrected) = (&mut s.mu[..m], &mut s.corrected[..m + 1]);
+    let (c_prime, d_prime) = (&mut s.c_prime[..m], &mut s.d_prime[..m]);
     let mut previous_worst = f64::INFINITY;
-    for _ in 0..MAX_NEWTON_ITERATIONS {
-        // Bond vectors and residuals under the current multipliers, and the Jacobian's diagonal.
-        let mut worst = 0.0f64;
-        let mut scale = 0.0f64;
-        for k in 0..m {
-            let mut b = p[k + 1] - p[k] + d[k] * ((w(k) + w(k + 1)) * lambda[k]);
-            if k > 0 {
-                b -= d[k - 1] * (w(k) * lambda[k - 1]);
+    for iteration in 0..MAX_NEWTON_ITERATIONS {
+        let mut pass = ForwardPass::default();
+        if iteration == 0 {
+            // No corrections yet: the bonds of `p`.
+            for k in 0..m {
+                pass.row(k, p[k + 1] - p[k], d, l2[k], inv_l2[k], c_prime, d_prime);
             }
-            if k + 1 < m {
-                b -= d[k + 1] * (w(k + 1) * lambda[k + 1]);
+        } else {
+            corrected[0] = p[0];
+            for k in 0..m {
+                let mut shift = d[k] * mu[k];
+                if k + 1 < m {
+                    shift -= d[k + 1] * mu[k + 1];
+                }
+                corrected[k + 1] = p[k + 1] + shift;
+                pass.row(k, corrected[k + 1] - corrected[k], d, l2[k], inv_l2[k], c_prime, d_prime);
             }
-            let l2 = lengths[k] as f64 * lengths[k] as f64;
-            let f = b.length_squared() - l2;
-            bonds[k] = b;
-            residual[k] = -f;
-            worst = worst.max((f / l2).abs());
-            diag[k] = 2.0 * (w(k) + w(k + 1)) * b.dot(d[k]);
-            scale = scale.max(diag[k].abs());
         }
         // Newton converges quadratically, so an iteration that fails to halve the error has reached the
         // rounding floor. (The system is solved in f64: its condition grows like n^2.)
+        let worst = pass.worst;
         if worst <= TOLERANCE || (worst > 0.5 * previous_worst && worst < STAGNATION_LIMIT) {
-            converged = true;
-            break;
+            if iteration > 0 {
+                p[1..].copy_from_slice(&corrected[1..]);
+            }
+            return true;
         }
         previous_worst = worst;
-        if !thomas_solve(d, bonds, diag, residual, c_prime, d_prime, lambda, dynamic_inv_mass, scale) {
-            break;
+        if !pass.pivots_usable() {
+            return false;
+        }
+        if iteration == 0 {
+            mu.fill(0.0);
+        }
+        // Back substitution. A non-finite entry makes every later one non-finite (`x - c * inf` is infinite or
+        // NaN, `0 * inf` NaN), so checking the last is enough; `mu` is reset before it is used again.
+        let mut next = 0.0f64;
+        for k in (0..m).rev() {
+            next = d_prime[k] - c_prime[k] * next;
+            mu[k] += next;
+        }
+        if !next.is_finite() {
+            return false;
         }
     }
-    if !converged {
-        return false;
-    }
-    for j in 1..=m {
-        let mut dp = d[j - 1] * lambda[j - 1];
-        if j < m {
-            dp -= d[j] * lambda[j];
-        }
-        p[j] += dp * w(j);
-    }
-    true
+    false
 }
 
-/// Solves the Newton system `J delta = residual` and adds `delta` to `lambda`. `J` is tridiagonal: its
-/// diagonal is given (largest magnitude `scale`), its off-diagonal entries `d F_k / d lambda_(k-+1)` are
-/// formed during the forward sweep. Returns `false` on a vanishing pivot or a non-finite result.
-// `!(x > y)` on purpose: a NaN must fail the check too.
-#[allow(clippy::neg_cmp_op_on_partial_ord, clippy::too_many_arguments)]
-#[inline]
-fn thomas_solve(
-    d: &[DVec3],
-    bonds: &[DVec3],
-    diag: &[f64],
-    residual: &[f64],
-    c_prime: &mut [f64],
-    d_prime: &mut [f64],
-    lambda: &mut [f64],
-    dynamic_inv_mass: f64,
+/// The running state of one root-to-tip pass of [`newton_along_directions`].
+struct ForwardPass {
+    /// Largest relative error `|F_k| / l_k^2`.
+    worst: f64,
+    /// Largest diagonal entry of `J`, and the smallest pivot of the elimination, by magnitude.
     scale: f64,
-) -> bool {
-    let m = lambda.len();
-    let (d, bonds, diag, residual) = (&d[..m], &bonds[..m], &diag[..m], &residual[..m]);
-    let (c_prime, d_prime) = (&mut c_prime[..m], &mut d_prime[..m]);
-    let w = |j: usize| inv_mass(j, dynamic_inv_mass);
-    let tiny = scale * 1e-7;
-    if !(scale > 0.0) {
-        return false;
+    smallest_pivot: f64,
+    c_last: f64,
+    d_last: f64,
+}
+
+impl Default for ForwardPass {
+    fn default() -> Self {
+        Self { worst: 0.0, scale: 0.0, smallest_pivot: f64::INFINITY, c_last: 0.0, d_last: 0.0 }
     }
-    // Forward elimination; one division per row.
-    let (mut c_last, mut d_last) = (0.0f64, 0.0f64);
-    for k in 0..m {
-        let b = bonds[k];
-        let lower = if k > 0 { -2.0 * w(k) * b.dot(d[k - 1]) } else { 0.0 };
-        let upper = if k + 1 < m { -2.0 * w(k + 1) * b.dot(d[k + 1]) } else { 0.0 };
-        let den = diag[k] - lower * c_last;
-        if !(den.abs() > tiny) {
-            return false;
+}
+
+impl ForwardPass {
+    /// Bond `k` with vector `b`: its error, and its row of the forward elimination (one division).
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn row(&mut self, k: usize, b: DVec3, d: &[DVec3], l2: f64, inv_l2: f64, c_prime: &mut [f64], d_prime: &mut [f64]) {
+        let m = d.len();
+        let f = b.length_squared() - l2;
+        let error = (f * inv_l2).abs();
+        // As `f64::max`: a NaN error is ignored here (and fails the elimination instead).
+        if error > self.worst {
+            self.worst = error;
+        }
+        // The root's end of bond 0 does not move, so bond 0's own correction counts once.
+        let diagonal = if k > 0 { 2.0 * b.dot(d[k]) } else { b.dot(d[k]) };
+        let lower = if k > 0 { -b.dot(d[k - 1]) } else { 0.0 };
+        let upper = if k + 1 < m { -b.dot(d[k + 1]) } else { 0.0 };
+        let den = diagonal - lower * self.c_last;
+        if diagonal.abs() > self.scale {
+            self.scale = diagonal.abs();
+        }
+        // As `f64::min`: a NaN pivot is skipped here but turns every later `d_prime` into NaN, so the back
+        // substitution fails.
+        if den.abs() < self.smallest_pivot {
+            self.smallest_pivot = den.abs();
         }
         let inv = 1.0 / den;
-        c_last = upper * inv;
-        d_last = (residual[k] - lower * d_last) * inv;
-        c_prime[k] = c_last;
-        d_prime[k] = d_last;
+        self.c_last = upper * inv;
+        self.d_last = (-0.5 * f - lower * self.d_last) * inv;
+        c_prime[k] = self.c_last;
+        d_prime[k] = self.d_last;
     }
-    let mut next = 0.0f64;
-    for k in (0..m).rev() {
-        let delta = d_prime[k] - c_prime[k] * next;
-        if !delta.is_finite() {
-            return false;
-        }
-        lambda[k] += delta;
-        next = delta;
+
+    /// No pivot vanished (relative to the largest diagonal entry); false for NaN too.
+    fn pivots_usable(&self) -> bool {
+        self.scale > 0.0 && self.smallest_pivot > self.scale * MIN_PIVOT
     }
-    true
 }
 
 /// Classic position-based projection along the current bonds: always well defined, slow to converge on
 /// long chains. Only used when the direct solve fails.
-fn project_gauss_seidel(p: &mut [DVec3], lengths: &[f32], dynamic_inv_mass: f32) {
-    let dynamic_inv_mass = dynamic_inv_mass as f64;
+fn project_gauss_seidel(p: &mut [DVec3], lengths: &[f32]) {
+    // Inverse masses relative to the uniform dynamic one.
+    let w = |j: usize| if j == 0 { 0.0 } else { 1.0f64 };
     for _ in 0..FALLBACK_SWEEPS {
         for (k, &rest) in lengths.iter().enumerate() {
-            let (wa, wb) = (inv_mass(k, dynamic_inv_mass), inv_mass(k + 1, dynamic_inv_mass));
+            let (wa, wb) = (w(k), w(k + 1));
             let delta = p[k + 1] - p[k];
             let len = delta.length();
-            if len <= f64::MIN_POSITIVE || wa + wb == 0.0 {
+            if len <= f64::MIN_POSITIVE {
                 continue;
             }
             let correction = delta * ((len - rest as f64) / (len * (wa + wb)));
@@ -221,7 +270,7 @@ mod tests {
         let mut p: Vec<DVec3> =
             x.iter().enumerate().map(|(i, v)| if i == 0 { *v } else { *v - DVec3::Y * 1.7e-4 }).collect();
         let mut s = ConstraintScratch::default();
-        assert!(solve(&x, &mut p, &lengths, 1.0, &mut s));
+        assert!(solve(&x, &mut p, &lengths, &mut s));
         assert!(max_stretch(&p, &lengths) < 1e-6, "{}", max_stretch(&p, &lengths));
         assert_eq!(p[0], x[0]);
     }
@@ -237,7 +286,7 @@ mod tests {
             .collect();
         p[0] = x[0];
         let mut s = ConstraintScratch::default();
-        assert!(solve(&x, &mut p, &lengths, 1.0, &mut s));
+        assert!(solve(&x, &mut p, &lengths, &mut s));
         assert!(max_stretch(&p, &lengths) < 1e-6, "{}", max_stretch(&p, &lengths));
     }
 
@@ -247,7 +296,7 @@ mod tests {
         let x = vec![DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)];
         let mut p = vec![DVec3::ZERO, DVec3::new(0.0, 3.0, 0.0), DVec3::new(0.0, 3.0, 2.0)];
         let mut s = ConstraintScratch::default();
-        assert!(!solve(&x, &mut p, &[1.0, 1.0], 1.0, &mut s));
+        assert!(!solve(&x, &mut p, &[1.0, 1.0], &mut s));
         assert!(p.iter().all(|v| v.is_finite()));
         assert!(max_stretch(&p, &[1.0, 1.0]) < 1e-3);
     }

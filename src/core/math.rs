@@ -108,6 +108,42 @@ pub fn swing_to(q: Quat, axis: Vec3, direction: Vec3) -> Quat {
     (shortest_arc(current, direction) * q).normalize()
 }
 
+/// `exp` of a rotation vector: the quaternion turning by `|e|` about `e`, as `Quat::from_scaled_axis`. Short
+/// vectors (the usual case: a particle's turn in one substep, a solver correction) use Taylor series accurate
+/// to float32 rounding up to 1 radian, with no square root and no call to `sincosf`.
+#[inline]
+pub fn exp_small(e: Vec3) -> Quat {
+    let x2 = 0.25 * e.length_squared();
+    if x2 <= 0.25 {
+        // cos(x) and sin(x)/x for the half angle x = |e|/2 <= 0.5; the first omitted terms are < 3e-10.
+        let cos = 1.0 + x2 * (-1.0 / 2.0 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0))));
+        let sinc = 1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0))));
+        let v = e * (0.5 * sinc);
+        Quat::from_xyzw(v.x, v.y, v.z, cos)
+    } else {
+        Quat::from_scaled_axis(e)
+    }
+}
+
+/// `log` of a unit quaternion: its rotation vector, as `Quat::to_scaled_axis`. Rotations by less than about
+/// 0.4 radians with `w > 0` (the usual case: a particle's turn in one substep) use a series accurate to
+/// float32 rounding, with no call to `atan2f`.
+#[inline]
+pub fn log_small(q: Quat) -> Vec3 {
+    let v = q.xyz();
+    let s2 = v.length_squared();
+    // Below glam's threshold `to_scaled_axis` returns zero; the exact path keeps that.
+    if q.w > 0.0 && s2 <= 0.04 * (q.w * q.w) && s2 >= 1e-16 {
+        // `2 atan2(s, w) / s = (2 / w) atan(t) / t` with `t = s / w <= 0.2`; the first omitted term is < 1e-8.
+        let inv_w = 1.0 / q.w;
+        let t2 = s2 * inv_w * inv_w;
+        let atan_t_over_t = 1.0 + t2 * (-1.0 / 3.0 + t2 * (1.0 / 5.0 + t2 * (-1.0 / 7.0 + t2 * (1.0 / 9.0))));
+        v * (2.0 * inv_w * atan_t_over_t)
+    } else {
+        q.to_scaled_axis()
+    }
+}
+
 /// Angle of the rotation `q` in radians, in [0, pi].
 #[inline]
 pub fn rotation_angle(q: Quat) -> f32 {
@@ -189,6 +225,25 @@ mod tests {
         assert_eq!(normalized_direction(Vec3::new(1e-20, 0.0, 0.0)), Some(Vec3::X));
         assert_eq!(normalized_direction(Vec3::new(0.0, -3e38, 0.0)), Some(-Vec3::Y));
         assert!(normalized_direction(Vec3::ZERO).is_none());
+    }
+
+    #[test]
+    fn series_exp_and_log_match_the_exact_functions() {
+        let axis = Vec3::new(0.3, -0.8, 0.5).normalize();
+        for angle in [0.0f32, 1e-9, 1e-7, 1e-4, 0.01, 0.1, 0.3, 0.39, 0.41, 0.9, 1.0, 1.1, 2.5] {
+            let e = axis * angle;
+            let exact = Quat::from_scaled_axis(e);
+            let series = exp_small(e);
+            assert!((series - exact).length() <= 2.0 * f32::EPSILON, "exp at {angle}: {series:?} vs {exact:?}");
+            let back = log_small(exact);
+            let reference = exact.to_scaled_axis();
+            let tolerance = 4.0 * f32::EPSILON * angle.max(f32::MIN_POSITIVE);
+            assert!((back - reference).length() <= tolerance, "log at {angle}: {back} vs {reference}");
+        }
+        // The other hemisphere and the identity take the exact path.
+        let far = -Quat::from_scaled_axis(axis * 0.1);
+        assert_eq!(log_small(far), far.to_scaled_axis());
+        assert_eq!(log_small(Quat::IDENTITY), Vec3::ZERO);
     }
 
     #[test]

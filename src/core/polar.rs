@@ -9,7 +9,9 @@
 //! reaches float precision in one or two steps; elsewhere (far from the answer, rank-deficient matrices) it
 //! is Müller's step unchanged. Everything is evaluated in the current rotation's frame, `S = R^T A`.
 
-use glam::{Mat3, Quat, Vec3};
+use glam::{Mat3A, Quat, Vec3};
+
+use super::math::exp_small;
 
 /// Rotation updates below this (radians) change nothing at float32 precision.
 const CONVERGED_ANGLE: f32 = 1e-7;
@@ -18,33 +20,36 @@ const MAX_NEWTON_ANGLE: f32 = 0.5;
 /// Relative size of the Hessian's smallest pivot below which it counts as singular.
 const MIN_PIVOT: f32 = 1e-4;
 
-/// Improves `q` in place towards the rotation part of `a`, for at most `max_iterations` iterations.
+/// Improves `q` in place towards the rotation part of `a`, for at most `max_iterations` iterations. Returns
+/// the rotation matrix of the final `q` (the convergence test has usually just computed it).
 #[inline]
-pub fn extract_rotation(a: &Mat3, q: &mut Quat, max_iterations: u32) {
+pub fn extract_rotation(a: &Mat3A, q: &mut Quat, max_iterations: u32) -> Mat3A {
     // The guard against a vanishing denominator scales with the matrix, so a millimetre-sized chain (entries
     // ~1e-7) is treated exactly like a metre-sized one.
     let guard = 1e-9 * (a.x_axis.length_squared() + a.y_axis.length_squared() + a.z_axis.length_squared()).sqrt()
         + f32::MIN_POSITIVE;
     for _ in 0..max_iterations {
+        let r = Mat3A::from_quat(*q);
         // Columns of `S = R^T A`: `s.col(c)[r] = r_r . a_c`.
-        let s = Mat3::from_quat(*q).transpose() * *a;
+        let s = r.transpose() * *a;
         // Gradient of `tr(R^T A)` over a rotation `R exp([e])`, in the frame of `R`: the axial vector of
         // `S - S^T`, equal to `R^T sum_i r_i x a_i` of Müller's formulation.
         let g = Vec3::new(s.y_axis.z - s.z_axis.y, s.z_axis.x - s.x_axis.z, s.x_axis.y - s.y_axis.x);
         let trace = s.x_axis.x + s.y_axis.y + s.z_axis.z;
         let muller = g / (trace.abs() + guard);
         if muller.length_squared() < CONVERGED_ANGLE * CONVERGED_ANGLE {
-            break;
+            return r;
         }
         let step = newton_step(&s, g, trace).unwrap_or(muller);
         *q = renormalize(*q * exp_small(step));
     }
+    Mat3A::from_quat(*q)
 }
 
 /// The Newton step `H^-1 g` with `H = tr(S) I - sym(S)` (the Hessian of `-tr(R^T A)`), if `H` is safely
 /// positive definite and the step short.
 #[inline]
-fn newton_step(s: &Mat3, g: Vec3, trace: f32) -> Option<Vec3> {
+fn newton_step(s: &Mat3A, g: Vec3, trace: f32) -> Option<Vec3> {
     let (h00, h11, h22) = (trace - s.x_axis.x, trace - s.y_axis.y, trace - s.z_axis.z);
     let h01 = -0.5 * (s.y_axis.x + s.x_axis.y);
     let h02 = -0.5 * (s.z_axis.x + s.x_axis.z);
@@ -72,22 +77,6 @@ fn newton_step(s: &Mat3, g: Vec3, trace: f32) -> Option<Vec3> {
     (step.length_squared() <= MAX_NEWTON_ANGLE * MAX_NEWTON_ANGLE).then_some(step)
 }
 
-/// `exp` of a rotation vector: the quaternion turning by `|e|` about `e`. Short vectors (the usual case)
-/// use Taylor series accurate to float32 rounding up to 1 radian, and need no square root.
-#[inline]
-fn exp_small(e: Vec3) -> Quat {
-    let x2 = 0.25 * e.length_squared();
-    if x2 <= 0.25 {
-        // cos(x) and sin(x)/x for the half angle x = |e|/2 <= 0.5; the first omitted terms are < 3e-10.
-        let cos = 1.0 + x2 * (-1.0 / 2.0 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0))));
-        let sinc = 1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0))));
-        let v = e * (0.5 * sinc);
-        Quat::from_xyzw(v.x, v.y, v.z, cos)
-    } else {
-        Quat::from_scaled_axis(e)
-    }
-}
-
 /// `q / |q|` for a `q` within a few float32 roundings of unit length (one Newton step on `1/|q|`: exact to
 /// float precision there, and no square root or division).
 #[inline]
@@ -99,27 +88,29 @@ fn renormalize(q: Quat) -> Quat {
 mod tests {
     use super::*;
     use crate::core::math::rotation_angle;
-    use glam::Vec3;
+    use glam::{Vec3, Vec3A};
 
     #[test]
     fn recovers_rotation_of_stretched_matrix() {
         let truth = Quat::from_euler(glam::EulerRot::YXZ, 0.8, -0.4, 1.9);
-        let stretch = Mat3::from_diagonal(Vec3::new(2.0, 0.5, 1.3));
-        let a = Mat3::from_quat(truth) * stretch;
+        let stretch = Mat3A::from_diagonal(Vec3::new(2.0, 0.5, 1.3));
+        let a = Mat3A::from_quat(truth) * stretch;
         let mut q = Quat::IDENTITY;
-        extract_rotation(&a, &mut q, 100);
+        let frame = extract_rotation(&a, &mut q, 100);
         assert!(rotation_angle(q.inverse() * truth) < 1e-4);
+        assert_eq!(frame, Mat3A::from_quat(q));
     }
 
     #[test]
     fn warm_start_converges_in_few_iterations() {
         // Near the answer the Newton step converges quadratically: float precision in two iterations.
         let truth = Quat::from_euler(glam::EulerRot::XYZ, 0.5, 0.2, -0.1);
-        let stretch = Mat3::from_diagonal(Vec3::new(1.0, 0.05, 0.02));
-        for a in [Mat3::from_quat(truth), Mat3::from_quat(truth) * stretch] {
+        let stretch = Mat3A::from_diagonal(Vec3::new(1.0, 0.05, 0.02));
+        for a in [Mat3A::from_quat(truth), Mat3A::from_quat(truth) * stretch] {
             let mut q = Quat::from_euler(glam::EulerRot::XYZ, 0.45, 0.22, -0.12);
             let start = rotation_angle(q.inverse() * truth);
-            extract_rotation(&a, &mut q, 1);
+            let frame = extract_rotation(&a, &mut q, 1);
+            assert_eq!(frame, Mat3A::from_quat(q));
             let first = rotation_angle(q.inverse() * truth);
             assert!(first < 0.05 * start, "{first} vs {start}");
             extract_rotation(&a, &mut q, 1);
@@ -133,7 +124,7 @@ mod tests {
     fn thin_matrix_twist_converges() {
         // A rod-like group: one large singular value. Müller's plain step would crawl on the twist.
         let truth = Quat::from_rotation_y(0.3) * Quat::from_rotation_x(0.2);
-        let a = Mat3::from_quat(truth) * Mat3::from_diagonal(Vec3::new(1e-2, 1.0, 1e-2));
+        let a = Mat3A::from_quat(truth) * Mat3A::from_diagonal(Vec3::new(1e-2, 1.0, 1e-2));
         let mut q = Quat::from_rotation_x(0.2);
         extract_rotation(&a, &mut q, 8);
         assert!(rotation_angle(q.inverse() * truth) < 1e-5, "{}", rotation_angle(q.inverse() * truth));
@@ -142,7 +133,7 @@ mod tests {
     #[test]
     fn rank_deficient_matrix_stays_finite() {
         // A two-point group without orientation terms: rank 1.
-        let a = Mat3::from_cols(Vec3::new(0.0, 1.0, 0.0), Vec3::ZERO, Vec3::ZERO);
+        let a = Mat3A::from_cols(Vec3A::new(0.0, 1.0, 0.0), Vec3A::ZERO, Vec3A::ZERO);
         let mut q = Quat::IDENTITY;
         extract_rotation(&a, &mut q, 20);
         assert!(q.is_finite() && (q.length() - 1.0).abs() < 1e-5);
@@ -153,7 +144,7 @@ mod tests {
     #[test]
     fn zero_matrix_leaves_guess() {
         let mut q = Quat::from_rotation_x(0.3);
-        extract_rotation(&Mat3::ZERO, &mut q, 10);
+        extract_rotation(&Mat3A::ZERO, &mut q, 10);
         assert_eq!(q, Quat::from_rotation_x(0.3));
     }
 }

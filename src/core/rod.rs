@@ -2,11 +2,11 @@
 //! inextensible by [`inextensible`](super::inextensible). This module advances one chain by one internal
 //! substep; the engine decides when and with which kinematic input.
 
-use glam::{DVec3, Mat3, Quat, Vec3};
+use glam::{DVec3, Mat3A, Quat, Vec3, Vec3A};
 
 use super::collision::{ContactInput, collide, pre_stabilise};
 use super::inextensible::{self, ConstraintScratch};
-use super::math::{Transform, align_hemisphere, nlerp_shorter};
+use super::math::{Transform, align_hemisphere, exp_small, log_small, nlerp_shorter};
 use super::polar::extract_rotation;
 use super::shape::Shape;
 
@@ -97,10 +97,13 @@ pub struct SubstepInput<'a> {
     /// Fraction of the way to the shape-matching goals per iteration.
     pub alpha_per_iteration: f32,
     pub iterations: u32,
-    pub inv_mass: f32,
     /// `a^2 / 5`: weight of particle orientations in the group matrix.
     pub orientation_weight: f32,
     pub rest: &'a Shape,
+    /// Derived from `rest`.
+    pub rest_groups: &'a RestGroups,
+    /// The shortest of the segment lengths.
+    pub shortest_segment: f32,
     /// First substep after placement: a half gravity kick starts the leapfrog.
     pub half_kick: bool,
     /// The colliders this chain can touch during this substep; `None` runs no collision code.
@@ -148,13 +151,16 @@ pub fn substep(
     scratch.reserve(n);
     let h = input.h;
     let RodScratch { p, qp, p_old, constraints } = scratch;
-    let settled = CONTACT_SETTLED * lengths.iter().copied().fold(f32::INFINITY, f32::min);
+    let settled = CONTACT_SETTLED * input.shortest_segment;
     if let Some(contacts) = &input.contacts {
         let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
-            inextensible::solve(previous, x, lengths, input.inv_mass, constraints);
+            inextensible::solve(previous, x, lengths, constraints);
         };
         pre_stabilise(&mut state.x, &mut p_old[..n], contacts, FINAL_CONTACT_ROUNDS, keep_lengths, settled);
     }
+    // The start positions give the inextensibility solve its correction directions; only the contact pass
+    // moves them (joints already inside a collider), and every solve after it is prepared again.
+    inextensible::prepare(&state.x, lengths, constraints);
     let (p, qp) = (&mut p[..n], &mut qp[..n]);
 
     // Kinematic root.
@@ -170,7 +176,7 @@ pub fn substep(
         state.v[i] = root_velocity + relative * input.velocity_decay + input.gravity * kick;
         state.w[i] *= input.velocity_decay;
         p[i] = state.x[i] + (state.v[i] * h).as_dvec3();
-        qp[i] = (Quat::from_scaled_axis(state.w[i] * h) * state.q[i]).normalize();
+        qp[i] = (exp_small(state.w[i] * h) * state.q[i]).normalize();
     }
 
     let alpha = input.alpha_per_iteration;
@@ -178,11 +184,20 @@ pub fn substep(
     let mut report = SubstepReport::default();
     for iteration in 0..iterations {
         if alpha > 0.0 {
-            match_shape(&mut state.group_rotation, p, qp, input.rest, input.orientation_weight, alpha);
+            match_shape(
+                &mut state.group_rotation,
+                p,
+                qp,
+                input.rest,
+                input.rest_groups,
+                input.orientation_weight,
+                alpha,
+            );
         }
-        report.fallback |= !inextensible::solve(&state.x, p, lengths, input.inv_mass, constraints);
+        report.fallback |= !inextensible::solve_prepared(p, lengths, constraints);
         if let Some(contacts) = &input.contacts {
             let mut pass = collide(&mut state.x, p, contacts);
+            inextensible::prepare(&state.x, lengths, constraints);
             report.contact_pairs += pass.tested;
             // A collider pushing hard (a swinging arm) moves a few particles far in one substep; the rest of
             // the chain follows through more rounds of lengths then contacts. The substep ends on contacts.
@@ -191,8 +206,9 @@ pub fn substep(
                     if !pass.touching || pass.deepest <= settled {
                         break;
                     }
-                    report.fallback |= !inextensible::solve(&state.x, p, lengths, input.inv_mass, constraints);
+                    report.fallback |= !inextensible::solve_prepared(p, lengths, constraints);
                     pass = collide(&mut state.x, p, contacts);
+                    inextensible::prepare(&state.x, lengths, constraints);
                     report.contact_pairs += pass.tested;
                 }
             }
@@ -203,7 +219,7 @@ pub fn substep(
     let inv_h = 1.0 / h;
     for i in 1..n {
         state.v[i] = (p[i] - state.x[i]).as_vec3() * inv_h;
-        state.w[i] = align_hemisphere(qp[i] * state.q[i].inverse(), Quat::IDENTITY).to_scaled_axis() * inv_h;
+        state.w[i] = log_small(align_hemisphere(qp[i] * state.q[i].inverse(), Quat::IDENTITY)) * inv_h;
         state.x[i] = p[i];
         state.q[i] = qp[i];
     }
@@ -249,6 +265,46 @@ pub fn carry_to_new_rest(
     }
 }
 
+/// What the shape-matching groups need of a rest shape, derived once per rest shape (it changes at most once
+/// per step, while the groups are matched in every solver iteration of every substep).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RestGroups {
+    /// Indexed by a group's middle particle `i` (entry 0 unused): the rest offsets of its members `i-1, i, i+1`
+    /// from its rest centre. The root's group is centred on the root (see [`match_shape`]); the last group
+    /// has no third member (zero offset).
+    offsets: Vec<[Vec3A; 3]>,
+}
+
+impl RestGroups {
+    /// Recomputes everything from `rest` (reusing the allocation).
+    pub fn rebuild(&mut self, rest: &Shape) {
+        let xbar = &rest.positions;
+        let n = xbar.len();
+        self.offsets.clear();
+        self.offsets.push([Vec3A::ZERO; 3]);
+        if n < 2 {
+            return;
+        }
+        let root_offset = |j: usize| if j < n { Vec3A::from(xbar[j] - xbar[0]) } else { Vec3A::ZERO };
+        self.offsets.push([Vec3A::ZERO, root_offset(1), root_offset(2)]);
+        for i in 2..n {
+            let lo = i - 1;
+            let offsets = if i + 1 < n {
+                let c_rest = (Vec3::ZERO + xbar[lo] + xbar[i] + xbar[i + 1]) / 3.0;
+                [xbar[lo] - c_rest, xbar[i] - c_rest, xbar[i + 1] - c_rest]
+            } else {
+                let c_rest = (Vec3::ZERO + xbar[lo] + xbar[i]) / 2.0;
+                [xbar[lo] - c_rest, xbar[i] - c_rest, Vec3::ZERO]
+            };
+            self.offsets.push(offsets.map(Vec3A::from));
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.offsets.len()
+    }
+}
+
 /// One Gauss-Seidel pass over the shape-matching groups `{i-1, i, i+1}`, root to tip.
 ///
 /// The group holding the kinematic root is clamped to it: its frame is the root's orientation and its
@@ -260,6 +316,7 @@ fn match_shape(
     p: &mut [DVec3],
     qp: &mut [Quat],
     rest: &Shape,
+    groups: &RestGroups,
     orientation_weight: f32,
     alpha: f32,
 ) {
@@ -267,56 +324,54 @@ fn match_shape(
     if n < 2 {
         return;
     }
-    let (xbar, qbar, group_rotation) = (&rest.positions[..n], &rest.orientations[..n], &mut group_rotation[..n]);
+    debug_assert_eq!(groups.len(), n, "rest groups derived from another rest shape");
+    let (qbar, offsets, group_rotation) = (&rest.orientations[..n], &groups.offsets[..n], &mut group_rotation[..n]);
     let alpha_f64 = alpha as f64;
 
     // The root's group {0, 1, 2}.
     let rotation = (qp[0] * qbar[0].inverse()).normalize();
     group_rotation[1] = rotation;
-    let (centre, rest_centre) = (p[0], xbar[0]);
+    let centre = p[0];
     for j in 1..n.min(3) {
-        pull_to_goal(&mut p[j], centre, rotation * (xbar[j] - rest_centre), alpha_f64);
+        pull_to_goal(&mut p[j], centre, rotation * offsets[1][j], alpha_f64);
     }
     qp[1] = nlerp_shorter(qp[1], rotation * qbar[1], alpha);
 
     // A member's orientation term does not change between the group where it is the last member and the
     // next one, where it is the middle member (a group only turns its middle particle): computed once.
-    let mut carried: Option<Mat3> = None;
+    let mut carried: Option<Mat3A> = None;
     for i in 2..n {
         let lo = i - 1;
         let full = i + 1 < n;
-        let orientation_term = |j: usize| Mat3::from_quat(qp[j] * qbar[j].inverse()) * orientation_weight;
+        let [r_lo, r_mid, r_hi] = offsets[i];
+        let orientation_term = |j: usize| Mat3A::from_quat(qp[j] * qbar[j].inverse()) * orientation_weight;
         let m_lo = orientation_term(lo);
         let m_mid = carried.take().unwrap_or_else(|| orientation_term(i));
         // Uniform masses cancel out of the group matrix.
-        let (c, a, r_lo, r_mid, r_hi) = if full {
+        let (c, a) = if full {
             let hi = i + 1;
             let m_hi = orientation_term(hi);
             carried = Some(m_hi);
             let c = (DVec3::ZERO + p[lo] + p[i] + p[hi]) / 3.0;
-            let c_rest = (Vec3::ZERO + xbar[lo] + xbar[i] + xbar[hi]) / 3.0;
-            let (r_lo, r_mid, r_hi) = (xbar[lo] - c_rest, xbar[i] - c_rest, xbar[hi] - c_rest);
             let a = m_lo
-                + outer((p[lo] - c).as_vec3(), r_lo)
+                + outer((p[lo] - c).as_vec3a(), r_lo)
                 + m_mid
-                + outer((p[i] - c).as_vec3(), r_mid)
+                + outer((p[i] - c).as_vec3a(), r_mid)
                 + m_hi
-                + outer((p[hi] - c).as_vec3(), r_hi);
-            (c, a, r_lo, r_mid, r_hi)
+                + outer((p[hi] - c).as_vec3a(), r_hi);
+            (c, a)
         } else {
             let c = (DVec3::ZERO + p[lo] + p[i]) / 2.0;
-            let c_rest = (Vec3::ZERO + xbar[lo] + xbar[i]) / 2.0;
-            let (r_lo, r_mid) = (xbar[lo] - c_rest, xbar[i] - c_rest);
-            let a = m_lo + outer((p[lo] - c).as_vec3(), r_lo) + m_mid + outer((p[i] - c).as_vec3(), r_mid);
-            (c, a, r_lo, r_mid, Vec3::ZERO)
+            let a = m_lo + outer((p[lo] - c).as_vec3a(), r_lo) + m_mid + outer((p[i] - c).as_vec3a(), r_mid);
+            (c, a)
         };
         let mut rotation = group_rotation[i];
-        extract_rotation(&a, &mut rotation, POLAR_ITERATIONS);
+        let frame = extract_rotation(&a, &mut rotation, POLAR_ITERATIONS);
         group_rotation[i] = rotation;
-        pull_to_goal(&mut p[lo], c, rotation * r_lo, alpha_f64);
-        pull_to_goal(&mut p[i], c, rotation * r_mid, alpha_f64);
+        pull_to_goal(&mut p[lo], c, frame * r_lo, alpha_f64);
+        pull_to_goal(&mut p[i], c, frame * r_mid, alpha_f64);
         if full {
-            pull_to_goal(&mut p[i + 1], c, rotation * r_hi, alpha_f64);
+            pull_to_goal(&mut p[i + 1], c, frame * r_hi, alpha_f64);
         }
         qp[i] = nlerp_shorter(qp[i], rotation * qbar[i], alpha);
     }
@@ -324,13 +379,13 @@ fn match_shape(
 
 /// `p` moved the fraction `alpha` of the way to its shape-matching goal `centre + offset`.
 #[inline(always)]
-fn pull_to_goal(p: &mut DVec3, centre: DVec3, offset: Vec3, alpha: f64) {
+fn pull_to_goal(p: &mut DVec3, centre: DVec3, offset: Vec3A, alpha: f64) {
     let goal = centre + offset.as_dvec3();
     *p += (goal - *p) * alpha;
 }
 
 /// `u v^T`.
 #[inline(always)]
-fn outer(u: Vec3, v: Vec3) -> Mat3 {
-    Mat3::from_cols(u * v.x, u * v.y, u * v.z)
+fn outer(u: Vec3A, v: Vec3A) -> Mat3A {
+    Mat3A::from_cols(u * v.x, u * v.y, u * v.z)
 }

@@ -12,6 +12,8 @@ const MAX_NEWTON_ITERATIONS: usize = 8;
 /// Largest error still accepted as a rounding floor when Newton stops improving.
 const STAGNATION_LIMIT: f64 = 1e-3;
 const FALLBACK_SWEEPS: usize = 64;
+/// Iterations of the relinearized fallback (it converges in 3 to 6 where it converges at all).
+const RELINEARIZED_ITERATIONS: usize = 16;
 /// A pivot of the Newton system smaller than this share of its largest diagonal entry counts as vanishing.
 const MIN_PIVOT: f64 = 1e-7;
 
@@ -76,9 +78,10 @@ pub fn prepare(x: &[DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
 
 /// Moves `p` so that `|p[k+1] - p[k]| = lengths[k]` for every bond, correcting along the previous
 /// positions' bonds `x[k+1] - x[k]`. Particle 0 never moves. Returns `false` when that direct solve failed
-/// (a bond turned by about 90 degrees in one substep, as at the tip of a whipping rope) and the fallback
-/// ran: the same Newton solve along the current bonds (always well conditioned, not symplectic), then, if
-/// even that fails, Gauss-Seidel projection.
+/// (a bond turned by about 90 degrees in one substep, as at the tip of a whipping rope, or a long chain of
+/// millimetre segments whose multipliers dwarf its segments) and the fallback ran: a Gauss-Newton projection
+/// along the current bonds, re-read every iteration (not symplectic), then, if even that fails, Gauss-Seidel
+/// projection.
 pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> bool {
     prepare(x, lengths, s);
     solve_prepared(p, lengths, s)
@@ -95,8 +98,61 @@ pub fn solve_prepared(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratc
     for k in 0..m {
         s.current_bonds[k] = p[k + 1] - p[k];
     }
-    if !newton_along_directions(p, &s.current_bonds[..m], l2, inv_l2, &mut s.newton) {
+    if !project_relinearized(p, &mut s.current_bonds[..m], l2, inv_l2, &mut s.newton) {
         project_gauss_seidel(p, lengths);
+    }
+    false
+}
+
+/// Gauss-Newton projection of `p` onto the bond lengths: each iteration corrects along the bonds as they are
+/// then (`d` is scratch for them), so unlike [`newton_along_directions`] it follows the chain as it turns.
+/// That matters on long, fine chains (hundreds of millimetre segments), where the multipliers of one substep
+/// are many segment lengths and directions fixed for the whole solve send it astray. Applies the corrections
+/// as it goes; returns `false` (with `p` finite but not yet converged) when it fails.
+fn project_relinearized(
+    p: &mut [DVec3],
+    d: &mut [DVec3],
+    length_squared: &[f64],
+    inverse_length_squared: &[f64],
+    s: &mut NewtonScratch,
+) -> bool {
+    let m = d.len();
+    let p = &mut p[..m + 1];
+    let (l2, inv_l2) = (&length_squared[..m], &inverse_length_squared[..m]);
+    let (mu, c_prime, d_prime) = (&mut s.mu[..m], &mut s.c_prime[..m], &mut s.d_prime[..m]);
+    let mut previous_worst = f64::INFINITY;
+    for _ in 0..RELINEARIZED_ITERATIONS {
+        for k in 0..m {
+            d[k] = p[k + 1] - p[k];
+        }
+        let mut pass = ForwardPass::default();
+        for k in 0..m {
+            pass.row(k, d[k], d, l2[k], inv_l2[k], c_prime, d_prime);
+        }
+        // As in `newton_along_directions`: converged, or at the rounding floor.
+        let worst = pass.worst;
+        if worst <= TOLERANCE || (worst > 0.5 * previous_worst && worst < STAGNATION_LIMIT) {
+            return true;
+        }
+        previous_worst = worst;
+        if !pass.pivots_usable() {
+            return false;
+        }
+        let mut next = 0.0f64;
+        for k in (0..m).rev() {
+            next = d_prime[k] - c_prime[k] * next;
+            mu[k] = next;
+        }
+        if !next.is_finite() {
+            return false;
+        }
+        for j in 1..=m {
+            let mut shift = d[j - 1] * mu[j - 1];
+            if j < m {
+                shift -= d[j] * mu[j];
+            }
+            p[j] += shift;
+        }
     }
     false
 }

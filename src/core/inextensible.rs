@@ -129,29 +129,15 @@ fn project_relinearized(
         for k in 0..m {
             pass.row(k, d[k], d, l2[k], inv_l2[k], c_prime, d_prime);
         }
-        // As in `newton_along_directions`: converged, or at the rounding floor.
-        let worst = pass.worst;
-        if worst <= TOLERANCE || (worst > 0.5 * previous_worst && worst < STAGNATION_LIMIT) {
+        if pass.converged(previous_worst) {
             return true;
         }
-        previous_worst = worst;
-        if !pass.pivots_usable() {
-            return false;
-        }
-        let mut next = 0.0f64;
-        for k in (0..m).rev() {
-            next = d_prime[k] - c_prime[k] * next;
-            mu[k] = next;
-        }
-        if !next.is_finite() {
+        previous_worst = pass.worst;
+        if !pass.pivots_usable() || !back_substitute(c_prime, d_prime, mu, Update::Replace) {
             return false;
         }
         for j in 1..=m {
-            let mut shift = d[j - 1] * mu[j - 1];
-            if j < m {
-                shift -= d[j] * mu[j];
-            }
-            p[j] += shift;
+            p[j] += shift(d, mu, j);
         }
     }
     false
@@ -189,42 +175,58 @@ fn newton_along_directions(
         } else {
             corrected[0] = p[0];
             for k in 0..m {
-                let mut shift = d[k] * mu[k];
-                if k + 1 < m {
-                    shift -= d[k + 1] * mu[k + 1];
-                }
-                corrected[k + 1] = p[k + 1] + shift;
+                corrected[k + 1] = p[k + 1] + shift(d, mu, k + 1);
                 pass.row(k, corrected[k + 1] - corrected[k], d, l2[k], inv_l2[k], c_prime, d_prime);
             }
         }
-        // Newton converges quadratically, so an iteration that fails to halve the error has reached the
-        // rounding floor. (The system is solved in f64: its condition grows like n^2.)
-        let worst = pass.worst;
-        if worst <= TOLERANCE || (worst > 0.5 * previous_worst && worst < STAGNATION_LIMIT) {
+        if pass.converged(previous_worst) {
             if iteration > 0 {
                 p[1..].copy_from_slice(&corrected[1..]);
             }
             return true;
         }
-        previous_worst = worst;
+        previous_worst = pass.worst;
         if !pass.pivots_usable() {
             return false;
         }
-        if iteration == 0 {
-            mu.fill(0.0);
-        }
-        // Back substitution. A non-finite entry makes every later one non-finite (`x - c * inf` is infinite or
-        // NaN, `0 * inf` NaN), so checking the last is enough; `mu` is reset before it is used again.
-        let mut next = 0.0f64;
-        for k in (0..m).rev() {
-            next = d_prime[k] - c_prime[k] * next;
-            mu[k] += next;
-        }
-        if !next.is_finite() {
+        let update = if iteration == 0 { Update::Replace } else { Update::Add };
+        if !back_substitute(c_prime, d_prime, mu, update) {
             return false;
         }
     }
     false
+}
+
+/// How [`back_substitute`] writes its solution into the multipliers.
+#[derive(Clone, Copy, PartialEq)]
+enum Update {
+    Replace,
+    Add,
+}
+
+/// The Thomas algorithm's pass back: solves for the step from the forward elimination's `c_prime` and
+/// `d_prime` and replaces `mu` with it or adds it. Returns `false` if the step is not finite (`mu` is then
+/// written over by the next solve before it is read).
+#[inline]
+fn back_substitute(c_prime: &[f64], d_prime: &[f64], mu: &mut [f64], update: Update) -> bool {
+    // A non-finite entry makes every later one non-finite (`x - c * inf` is infinite or NaN, `0 * inf` NaN),
+    // so checking the last is enough.
+    let mut next = 0.0f64;
+    for k in (0..mu.len()).rev() {
+        next = d_prime[k] - c_prime[k] * next;
+        match update {
+            Update::Replace => mu[k] = next,
+            Update::Add => mu[k] += next,
+        }
+    }
+    next.is_finite()
+}
+
+/// How far the multipliers `mu` along the directions `d` move particle `j >= 1`.
+#[inline(always)]
+fn shift(d: &[DVec3], mu: &[f64], j: usize) -> DVec3 {
+    let pulled = d[j - 1] * mu[j - 1];
+    if j < d.len() { pulled - d[j] * mu[j] } else { pulled }
 }
 
 /// The running state of one root-to-tip pass of [`newton_along_directions`].
@@ -274,6 +276,12 @@ impl ForwardPass {
         self.d_last = (-0.5 * f - lower * self.d_last) * inv;
         c_prime[k] = self.c_last;
         d_prime[k] = self.d_last;
+    }
+
+    /// Converged, or at the rounding floor: Newton converges quadratically, so a pass that fails to halve the
+    /// error of the one before has reached it. (The system is solved in f64: its condition grows like n^2.)
+    fn converged(&self, previous_worst: f64) -> bool {
+        self.worst <= TOLERANCE || (self.worst > 0.5 * previous_worst && self.worst < STAGNATION_LIMIT)
     }
 
     /// No pivot vanished (relative to the largest diagonal entry); false for NaN too.

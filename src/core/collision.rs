@@ -125,12 +125,8 @@ fn collide_plane(start: &mut [DVec3], p: &mut [DVec3], sweep: &ColliderSweep, in
             let moved = sweep.start.to_local(start[j]);
             let overlapping_at_start = moved.y < input.radii[j] - input.slop;
             deepest = deepest.max(depth);
-            let correction =
-                Vec3::Y * depth + friction(local + Vec3::Y * depth - moved, Vec3::Y, depth, input.friction);
-            p[j] += sweep.end.direction_to_world(correction);
-            if overlapping_at_start {
-                start[j] += sweep.end.direction_to_world(Vec3::Y * depth);
-            }
+            let contact = Contact { normal: Vec3::Y, depth, overlapping_at_start };
+            contact.push_particle(&mut start[j], &mut p[j], sweep, local, moved, input.friction);
         }
     }
     ContactPass { tested: p.len() as u64 - 1, touching, deepest }
@@ -158,12 +154,8 @@ fn collide_inside(
             let overlapping_at_start = (moved - moved_axis_point).length() > limit + input.slop;
             let depth = distance - limit;
             deepest = deepest.max(depth);
-            let normal = -offset / distance;
-            let correction = normal * depth + friction(local + normal * depth - moved, normal, depth, input.friction);
-            p[j] += sweep.end.direction_to_world(correction);
-            if overlapping_at_start {
-                start[j] += sweep.end.direction_to_world(normal * depth);
-            }
+            let contact = Contact { normal: -offset / distance, depth, overlapping_at_start };
+            contact.push_particle(&mut start[j], &mut p[j], sweep, local, moved, input.friction);
         }
     }
     ContactPass { tested: p.len() as u64 - 1, touching, deepest }
@@ -202,14 +194,13 @@ fn collide_outside(
         let point = a.lerp(b, t);
         let reach = radius + input.radii[k] + (input.radii[k + 1] - input.radii[k]) * t;
         let before = sweep.start.to_local(start[k].lerp(start[k + 1], t as f64));
-        let Some(Contact { normal, depth, overlapping_at_start }) =
-            contact_outside(before, point, reach, half_height, input.slop)
-        else {
+        let Some(contact) = contact_outside(before, point, reach, half_height, input.slop) else {
             continue;
         };
+        let Contact { normal, depth, overlapping_at_start } = contact;
         touching = true;
         deepest = deepest.max(depth);
-        let correction = normal * depth + friction(point + normal * depth - before, normal, depth, input.friction);
+        let correction = contact.correction(point, before, input.friction);
         // Move the segment's two ends so that the point at `t` moves by `correction` (unit masses; the root's
         // inverse mass is 0).
         let (wa, wb) = (if k == 0 { 0.0 } else { 1.0 - t }, t);
@@ -259,6 +250,33 @@ struct Contact {
     depth: f32,
     /// The point was inside already at the start of the substep.
     overlapping_at_start: bool,
+}
+
+impl Contact {
+    /// The move of the contact point now at `now` (it was at `before` at the start of the substep, both in
+    /// the collider's frame): out along the normal, plus friction against its tangential motion.
+    fn correction(&self, now: Vec3, before: Vec3, coefficient: f32) -> Vec3 {
+        let push = self.normal * self.depth;
+        push + friction(now + push - before, self.normal, self.depth, coefficient)
+    }
+
+    /// Resolves the contact of one particle (`p` its position, `start` its position at the start of the
+    /// substep, `local` and `moved` the same in the collider's frame); a particle already inside at the start
+    /// has its start moved out too (pre-stabilisation), so the push adds no velocity.
+    fn push_particle(
+        &self,
+        start: &mut DVec3,
+        p: &mut DVec3,
+        sweep: &ColliderSweep,
+        local: Vec3,
+        moved: Vec3,
+        coefficient: f32,
+    ) {
+        *p += sweep.end.direction_to_world(self.correction(local, moved, coefficient));
+        if self.overlapping_at_start {
+            *start += sweep.end.direction_to_world(self.normal * self.depth);
+        }
+    }
 }
 
 fn fallback_normal(v: Vec3) -> Vec3 {

@@ -18,6 +18,10 @@ use kodawari::{ChainParams, Engine, EngineSettings, Transform};
 
 fn scene(chains: usize, joints: usize) -> Engine {
     let mut engine = Engine::new(EngineSettings::default()).expect("default settings are valid");
+    // `KDW_SOLVER=scalar` measures the scalar reference solver instead of the lane solver.
+    if std::env::var("KDW_SOLVER").is_ok_and(|s| s == "scalar") {
+        engine.set_solver(kodawari::Solver::Scalar);
+    }
     let base: Vec<Transform> =
         (0..joints).map(|i| Transform::new(Vec3::new(0.0, 0.1 + 0.03 * i as f32, 0.0), Quat::IDENTITY)).collect();
     for _ in 0..chains {

@@ -7,7 +7,7 @@ use super::arena::Id;
 use super::blend::blend_into;
 use super::error::{Error, Result};
 use super::math::{Transform, direction, nlerp_shorter, swing_to};
-use super::params::ChainParams;
+use super::params::{ChainParams, EngineSettings, SLEEP_DELAY};
 use super::rod::{RestGroups, RodState};
 use super::shape::{EncodedShape, Shape, ShapeFrame};
 use super::weights::{ViewWeighting, blend_weights};
@@ -306,6 +306,22 @@ impl Chain {
             };
             self.output[j + 1].position = self.output[j].position + blended * self.frame.lengths[j];
             self.output[j].rotation = swing_to(self.output[j].rotation, self.bone_axes[j], blended);
+        }
+    }
+
+    /// After a step's substeps: the output pose for render time `after` seconds past the newest internal state
+    /// (`h` the substep), and the way to sleep (`still`: nothing about the chain changed this step).
+    pub(crate) fn finish_step(&mut self, still: bool, substeps: u64, h: f64, after: f64, settings: &EngineSettings) {
+        self.write_output((after / h) as f32);
+        if settings.sleep_speed > 0.0 && substeps > 0 {
+            if still && self.relative_speed() < settings.sleep_speed * settings.scale {
+                self.still_time += (substeps as f64 * h) as f32;
+                if self.still_time >= SLEEP_DELAY {
+                    self.fall_asleep();
+                }
+            } else {
+                self.still_time = 0.0;
+            }
         }
     }
 

@@ -11,8 +11,9 @@ use super::chain::{Chain, ViewShape, ViewShapeId, relative_rotation};
 use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderSweep};
 use super::collision::ContactInput;
 use super::error::{Error, Result};
+use super::lanes::{Clock, LaneJob, LaneSolver, Solver};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
-use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, SLEEP_DELAY, TeleportMode};
+use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, TeleportMode};
 use super::rod::{RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
 
@@ -38,6 +39,25 @@ pub struct Stats {
     /// (segment or particle, collider) pairs the contact pass tested, over all steps: 0 while no chain can
     /// touch a collider.
     pub contact_pairs_tested: u64,
+}
+
+/// A chain's solver inputs that stay the same through a step.
+struct ChainConstants {
+    alpha_per_iteration: f32,
+    velocity_decay: f32,
+    gravity: Vec3,
+    orientation_weight: f32,
+}
+
+impl ChainConstants {
+    fn new(params: &ChainParams, settings: &EngineSettings, h: f32, iterations: u32) -> Self {
+        Self {
+            alpha_per_iteration: params.alpha_per_iteration(h, iterations),
+            velocity_decay: (-params.damping * h).exp(),
+            gravity: settings.gravity * (params.gravity_scale * settings.scale),
+            orientation_weight: (params.radius * settings.scale).powi(2) / 5.0,
+        }
+    }
 }
 
 /// Share of a chain's shortest segment a joint must have been inside a collider at the start of a substep to
@@ -66,6 +86,11 @@ pub struct Engine {
     joint_count: usize,
     scratch: RodScratch,
     contact_scratch: ContactScratch,
+    solver: Solver,
+    lanes: LaneSolver,
+    /// The chains the lane solver steps in the current step, and the anchor progress of each substep.
+    lane_jobs: Vec<LaneJob>,
+    progress: Vec<f32>,
     stats: Stats,
 }
 
@@ -99,6 +124,10 @@ impl Engine {
             joint_count: 0,
             scratch: RodScratch::default(),
             contact_scratch: ContactScratch::default(),
+            solver: Solver::default(),
+            lanes: LaneSolver::default(),
+            lane_jobs: Vec::new(),
+            progress: Vec::new(),
             stats: Stats::default(),
         })
     }
@@ -119,6 +148,16 @@ impl Engine {
         for &slot in &self.order {
             self.chains.at_mut(slot as usize).expect("live").wake();
         }
+    }
+
+    /// Which solver steps the chains that touch no collider ([`Solver::Lanes`] by default). Both give the same
+    /// motion up to float rounding; the scalar one is the reference the lane solver is tested against.
+    pub fn set_solver(&mut self, solver: Solver) {
+        self.solver = solver;
+    }
+
+    pub fn solver(&self) -> Solver {
+        self.solver
     }
 
     pub fn set_gravity(&mut self, gravity: Vec3) -> Result<()> {
@@ -607,26 +646,43 @@ impl Engine {
             }
 
             let params = chain.params;
-            let slop = CONTACT_SLOP * chain.frame.lengths.iter().copied().fold(f32::INFINITY, f32::min);
-            let alpha = params.alpha_per_iteration(h as f32, iterations);
-            let decay = (-params.damping * h as f32).exp();
-            let suppression_share = params.momentum_suppression * params.alpha_per_substep(h as f32);
-            for s in 0..substeps {
-                let anchor = start.interpolate(&target, progress(s));
+            let constants = ChainConstants::new(&params, &settings, h as f32, iterations);
+            if substeps > 0 {
                 if chain.rest_changed {
-                    if suppression_share > 0.0 {
+                    let share = params.momentum_suppression * params.alpha_per_substep(h as f32);
+                    if share > 0.0 {
+                        let anchor = start.interpolate(&target, progress(0));
                         carry_to_new_rest(
                             &mut chain.state,
                             &anchor,
                             &chain.rest_used,
                             &chain.rest,
-                            suppression_share,
+                            share,
                             &mut self.scratch,
                         );
                     }
                     chain.rest_used.clone_from(&chain.rest);
                     chain.rest_changed = false;
                 }
+                chain.refresh_rest_groups();
+            }
+            if self.solver == Solver::Lanes && self.contact_scratch.candidates.is_empty() && substeps > 0 {
+                self.lane_jobs.push(LaneJob {
+                    slot,
+                    joints: chain.joint_count(),
+                    start,
+                    target,
+                    alpha_per_iteration: constants.alpha_per_iteration,
+                    velocity_decay: constants.velocity_decay,
+                    gravity: constants.gravity,
+                    orientation_weight: constants.orientation_weight,
+                    still,
+                });
+                continue;
+            }
+            let slop = CONTACT_SLOP * chain.frame.lengths.iter().copied().fold(f32::INFINITY, f32::min);
+            for s in 0..substeps {
+                let anchor = start.interpolate(&target, progress(s));
                 let contacts = &mut self.contact_scratch;
                 let touching = !contacts.candidates.is_empty();
                 if touching {
@@ -634,15 +690,14 @@ impl Engine {
                     contacts.chain_sweeps.clear();
                     contacts.chain_sweeps.extend(contacts.candidates.iter().map(|&c| row[c]));
                 }
-                chain.refresh_rest_groups();
                 let input = SubstepInput {
                     h: h as f32,
                     anchor,
-                    gravity: settings.gravity * (params.gravity_scale * settings.scale),
-                    velocity_decay: decay,
-                    alpha_per_iteration: alpha,
+                    gravity: constants.gravity,
+                    velocity_decay: constants.velocity_decay,
+                    alpha_per_iteration: constants.alpha_per_iteration,
                     iterations,
-                    orientation_weight: (params.radius * settings.scale).powi(2) / 5.0,
+                    orientation_weight: constants.orientation_weight,
                     rest: &chain.rest,
                     rest_groups: &chain.rest_groups,
                     shortest_segment: chain.shortest_segment,
@@ -662,16 +717,16 @@ impl Engine {
                     chain.capture_local(&anchor);
                 }
             }
-            chain.write_output((after / h) as f32);
-            if settings.sleep_speed > 0.0 && substeps > 0 {
-                if still && chain.relative_speed() < settings.sleep_speed * settings.scale {
-                    chain.still_time += (substeps as f64 * h) as f32;
-                    if chain.still_time >= SLEEP_DELAY {
-                        chain.fall_asleep();
-                    }
-                } else {
-                    chain.still_time = 0.0;
-                }
+            chain.finish_step(still, substeps, h, after, &settings);
+        }
+        if !self.lane_jobs.is_empty() {
+            self.progress.clear();
+            self.progress.extend((0..substeps).map(progress));
+            let clock = Clock { h: h as f32, iterations, progress: &self.progress };
+            fallbacks += self.lanes.step(&mut self.chains, &mut self.lane_jobs, &clock);
+            for job in self.lane_jobs.drain(..) {
+                let chain = self.chains.at_mut(job.slot as usize).expect("live");
+                chain.finish_step(job.still, substeps, h, after, &settings);
             }
         }
         if substeps > 0 {

@@ -7,15 +7,15 @@ use glam::DVec3;
 
 /// Relative error of `|b|^2 / l^2 - 1` below which a bond counts as satisfied (about 5e-7 in length:
 /// the float32 floor).
-const TOLERANCE: f64 = 1e-9;
-const MAX_NEWTON_ITERATIONS: usize = 8;
+pub(crate) const TOLERANCE: f64 = 1e-9;
+pub(crate) const MAX_NEWTON_ITERATIONS: usize = 8;
 /// Largest error still accepted as a rounding floor when Newton stops improving.
-const STAGNATION_LIMIT: f64 = 1e-3;
+pub(crate) const STAGNATION_LIMIT: f64 = 1e-3;
 const FALLBACK_SWEEPS: usize = 64;
 /// Iterations of the relinearized fallback (it converges in 3 to 6 where it converges at all).
 const RELINEARIZED_ITERATIONS: usize = 16;
 /// A pivot of the Newton system smaller than this share of its largest diagonal entry counts as vanishing.
-const MIN_PIVOT: f64 = 1e-7;
+pub(crate) const MIN_PIVOT: f64 = 1e-7;
 
 /// Reusable buffers, one entry per bond unless noted. The dynamic particles' masses are uniform, so they
 /// cancel out of the solve: only the kinematic root's infinite mass (it never moves) shapes it.
@@ -95,13 +95,32 @@ pub fn solve_prepared(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratc
     if newton_along_directions(p, &s.start_bonds[..m], l2, inv_l2, &mut s.newton) {
         return true;
     }
+    fall_back(p, lengths, s);
+    false
+}
+
+/// What [`solve_prepared`] does when the direct solve fails, for a solver that ran its own direct solve (the
+/// lane path): the Gauss-Newton projection along the current bonds, then Gauss-Seidel if even that fails.
+pub fn solve_fallback(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
+    let m = lengths.len();
+    s.reserve(m);
+    for k in 0..m {
+        let l2 = lengths[k] as f64 * lengths[k] as f64;
+        s.length_squared[k] = l2;
+        s.inverse_length_squared[k] = 1.0 / l2;
+    }
+    fall_back(p, lengths, s);
+}
+
+fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
+    let m = lengths.len();
+    let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
     for k in 0..m {
         s.current_bonds[k] = p[k + 1] - p[k];
     }
     if !project_relinearized(p, &mut s.current_bonds[..m], l2, inv_l2, &mut s.newton) {
         project_gauss_seidel(p, lengths);
     }
-    false
 }
 
 /// Gauss-Newton projection of `p` onto the bond lengths: each iteration corrects along the bonds as they are

@@ -5,6 +5,7 @@
 //! - [`weights`]: view direction and blend weights (3.2)
 //! - [`blend`]: blending encoded shapes (3.3)
 //! - [`polar`], [`rod`], [`inextensible`]: the oriented-particle rod and its constraints (3.4)
+//! - [`lanes`]: the same rod, chains of equal length side by side in SIMD lanes
 //! - [`collider`], [`collision`]: colliders and the contact pass (3.7)
 //! - [`batch`]: many engines in one call (optionally on a thread pool)
 //! - [`params`]: settings, parameters, units
@@ -19,6 +20,7 @@ pub mod collision;
 pub mod engine;
 pub mod error;
 pub mod inextensible;
+pub mod lanes;
 pub mod math;
 pub mod params;
 pub mod polar;
@@ -32,5 +34,6 @@ pub use chain::ViewShapeId;
 pub use collider::{ColliderDef, ColliderId, ColliderShape};
 pub use engine::{ChainId, Engine, Stats};
 pub use error::{Error, ErrorKind, Result};
+pub use lanes::{Solver, simd_path};
 pub use math::Transform;
 pub use params::{AnchorSource, ChainParams, EngineSettings, TeleportMode};

@@ -14,11 +14,11 @@ use glam::{Mat3A, Quat, Vec3};
 use super::math::exp_small;
 
 /// Rotation updates below this (radians) change nothing at float32 precision.
-const CONVERGED_ANGLE: f32 = 1e-7;
+pub(crate) const CONVERGED_ANGLE: f32 = 1e-7;
 /// Newton steps longer than this (radians) are not trusted: the quadratic model is local.
-const MAX_NEWTON_ANGLE: f32 = 0.5;
+pub(crate) const MAX_NEWTON_ANGLE: f32 = 0.5;
 /// Relative size of the Hessian's smallest pivot below which it counts as singular.
-const MIN_PIVOT: f32 = 1e-4;
+pub(crate) const MIN_PIVOT: f32 = 1e-4;
 
 /// Improves `q` in place towards the rotation part of `a`, for at most `max_iterations` iterations. Returns
 /// the rotation matrix of the final `q` (the convergence test has usually just computed it).

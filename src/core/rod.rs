@@ -12,7 +12,7 @@ use super::shape::Shape;
 
 /// Warm-started rotation extraction (Newton steps where the problem is well conditioned) reaches float
 /// precision in 2-3 iterations and stops early once converged; the cap only bounds the worst case.
-const POLAR_ITERATIONS: u32 = 8;
+pub(crate) const POLAR_ITERATIONS: u32 = 8;
 
 /// Most rounds of (lengths, contacts) in the last solver iteration; they stop once the contacts move
 /// nothing by more than `CONTACT_SETTLED` of the shortest segment.
@@ -272,7 +272,7 @@ pub struct RestGroups {
     /// Indexed by a group's middle particle `i` (entry 0 unused): the rest offsets of its members `i-1, i, i+1`
     /// from its rest centre. The root's group is centred on the root (see [`match_shape`]); the last group
     /// has no third member (zero offset).
-    offsets: Vec<[Vec3A; 3]>,
+    pub(crate) offsets: Vec<[Vec3A; 3]>,
 }
 
 impl RestGroups {

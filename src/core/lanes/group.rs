@@ -1,0 +1,196 @@
+//! The structure-of-arrays buffers of one lane group: `L` chains of `n` joints, one lane each, loaded from the
+//! chains before a step's substeps and stored back after them.
+
+use glam::{DVec3, Quat, Vec3, Vec3A};
+
+use super::simd::{D, DV3, F, Mask, Q, V3};
+use crate::core::inextensible::ConstraintScratch;
+use crate::core::math::Transform;
+use crate::core::rod::RodState;
+use crate::core::shape::Shape;
+
+/// What one chain brings to a lane group for one step.
+pub(crate) struct LaneChain<'a> {
+    pub state: &'a RodState,
+    pub rest: &'a Shape,
+    /// `RestGroups` offsets of `rest`.
+    pub offsets: &'a [[Vec3A; 3]],
+    pub lengths: &'a [f32],
+    pub alpha_per_iteration: f32,
+    pub velocity_decay: f32,
+    pub gravity: Vec3,
+    pub orientation_weight: f32,
+    pub half_kick: bool,
+}
+
+/// Settings every lane of a group shares.
+#[derive(Clone, Copy)]
+pub(crate) struct GroupSettings {
+    pub joints: usize,
+    pub h: f32,
+    pub iterations: u32,
+    /// False for limp chains (stiffness 0): no shape matching, one iteration.
+    pub shape_matching: bool,
+    pub substeps: usize,
+}
+
+#[derive(Default)]
+pub struct LaneGroup<const L: usize> {
+    pub(super) n: usize,
+    pub(super) h: f32,
+    pub(super) iterations: u32,
+    pub(super) shape_matching: bool,
+    // Particle state.
+    pub(super) x: Vec<DV3<L>>,
+    pub(super) v: Vec<V3<L>>,
+    pub(super) q: Vec<Q<L>>,
+    pub(super) w: Vec<V3<L>>,
+    pub(super) group_rotation: Vec<Q<L>>,
+    // Rest shape and lengths.
+    pub(super) rest_root: V3<L>,
+    pub(super) qbar: Vec<Q<L>>,
+    pub(super) qbar_inv: Vec<Q<L>>,
+    pub(super) offsets: Vec<[V3<L>; 3]>,
+    pub(super) lengths: Vec<F<L>>,
+    pub(super) length_squared: Vec<D<L>>,
+    pub(super) inverse_length_squared: Vec<D<L>>,
+    // Per-chain parameters.
+    pub(super) alpha: F<L>,
+    pub(super) decay: F<L>,
+    pub(super) gravity: V3<L>,
+    pub(super) orientation_weight: F<L>,
+    pub(super) half_kick: Mask<L>,
+    /// The anchor (position, rotation) at the end of each substep of the step.
+    pub(super) anchors: Vec<(V3<L>, Q<L>)>,
+    // Solver scratch.
+    pub(super) p: Vec<DV3<L>>,
+    pub(super) qp: Vec<Q<L>>,
+    pub(super) start_bonds: Vec<DV3<L>>,
+    pub(super) corrected: Vec<DV3<L>>,
+    pub(super) mu: Vec<D<L>>,
+    pub(super) c_prime: Vec<D<L>>,
+    pub(super) d_prime: Vec<D<L>>,
+    // One lane at a time, for the scalar fallback.
+    pub(super) lane_p: Vec<DVec3>,
+    pub(super) lane_lengths: Vec<f32>,
+    pub(super) constraints: ConstraintScratch,
+}
+
+impl<const L: usize> Default for V3<L> {
+    fn default() -> Self {
+        Self::ZERO
+    }
+}
+
+impl<const L: usize> Default for F<L> {
+    fn default() -> Self {
+        Self([0.0; L])
+    }
+}
+
+impl<const L: usize> Default for Mask<L> {
+    fn default() -> Self {
+        Self([false; L])
+    }
+}
+
+impl<const L: usize> LaneGroup<L> {
+    /// Sizes the buffers for `settings` (allocates only when they grow).
+    pub(crate) fn begin(&mut self, settings: GroupSettings) {
+        let n = settings.joints;
+        self.n = n;
+        self.h = settings.h;
+        self.iterations = settings.iterations;
+        self.shape_matching = settings.shape_matching;
+        fn fit<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
+            if v.len() < len {
+                v.resize(len, value);
+            }
+        }
+        let zero_q = Q::IDENTITY;
+        for v in [&mut self.x, &mut self.p, &mut self.start_bonds, &mut self.corrected] {
+            fit(v, n, DV3::ZERO);
+        }
+        for v in [&mut self.v, &mut self.w] {
+            fit(v, n, V3::ZERO);
+        }
+        for v in [&mut self.q, &mut self.group_rotation, &mut self.qbar, &mut self.qbar_inv, &mut self.qp] {
+            fit(v, n, zero_q);
+        }
+        fit(&mut self.offsets, n, [V3::ZERO; 3]);
+        fit(&mut self.lengths, n, F([0.0; L]));
+        for v in [
+            &mut self.length_squared,
+            &mut self.inverse_length_squared,
+            &mut self.mu,
+            &mut self.c_prime,
+            &mut self.d_prime,
+        ] {
+            fit(v, n, D([0.0; L]));
+        }
+        fit(&mut self.anchors, settings.substeps, (V3::ZERO, zero_q));
+        self.lane_p.reserve(n);
+        self.lane_lengths.reserve(n);
+        self.constraints.reserve(n);
+    }
+
+    /// Loads one chain into `lane`.
+    pub(crate) fn load(&mut self, lane: usize, chain: &LaneChain<'_>) {
+        let n = self.n;
+        let st = chain.state;
+        debug_assert_eq!(st.x.len(), n);
+        for j in 0..n {
+            self.x[j].set(lane, st.x[j].to_array());
+            self.v[j].set(lane, st.v[j].to_array());
+            self.q[j].set(lane, st.q[j].to_array());
+            self.w[j].set(lane, st.w[j].to_array());
+            self.group_rotation[j].set(lane, st.group_rotation[j].to_array());
+            let qbar = chain.rest.orientations[j];
+            self.qbar[j].set(lane, qbar.to_array());
+            self.qbar_inv[j].set(lane, qbar.inverse().to_array());
+            let [a, b, c] = chain.offsets[j];
+            let offsets = &mut self.offsets[j];
+            offsets[0].set(lane, a.to_array());
+            offsets[1].set(lane, b.to_array());
+            offsets[2].set(lane, c.to_array());
+        }
+        self.rest_root.set(lane, chain.rest.positions[0].to_array());
+        for k in 0..n - 1 {
+            let l = chain.lengths[k];
+            let l2 = l as f64 * l as f64;
+            self.lengths[k].0[lane] = l;
+            self.length_squared[k].0[lane] = l2;
+            self.inverse_length_squared[k].0[lane] = 1.0 / l2;
+        }
+        self.alpha.0[lane] = chain.alpha_per_iteration;
+        self.decay.0[lane] = chain.velocity_decay;
+        self.gravity.set(lane, chain.gravity.to_array());
+        self.orientation_weight.0[lane] = chain.orientation_weight;
+        self.half_kick.0[lane] = chain.half_kick;
+    }
+
+    /// The anchor of `lane` at the end of substep `s` (relative to the engine origin).
+    pub(crate) fn set_anchor(&mut self, s: usize, lane: usize, anchor: &Transform) {
+        let (position, rotation) = &mut self.anchors[s];
+        position.set(lane, anchor.position.to_array());
+        rotation.set(lane, anchor.rotation.to_array());
+    }
+
+    /// Positions and orientations of `lane` into `state` (what the render capture reads).
+    pub(crate) fn store_pose(&self, lane: usize, state: &mut RodState) {
+        for j in 0..self.n {
+            state.x[j] = DVec3::from_array(self.x[j].get(lane));
+            state.q[j] = Quat::from_array(self.q[j].get(lane));
+        }
+    }
+
+    /// The whole particle state of `lane` into `state`.
+    pub(crate) fn store(&self, lane: usize, state: &mut RodState) {
+        self.store_pose(lane, state);
+        for j in 0..self.n {
+            state.v[j] = Vec3::from_array(self.v[j].get(lane));
+            state.w[j] = Vec3::from_array(self.w[j].get(lane));
+            state.group_rotation[j] = Quat::from_array(self.group_rotation[j].get(lane));
+        }
+    }
+}

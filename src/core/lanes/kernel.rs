@@ -1,0 +1,362 @@
+//! One substep of a lane group: [`rod::substep`](crate::core::rod::substep) without contacts, for `L`
+//! chains of the same joint count at once. Same algorithm, same constants, same order of operations within
+//! a lane; only the data layout differs (one array per quantity, one lane per chain). Where the scalar
+//! solver branches on a value (convergence, a rotation too large for a series, a failed direct solve), the
+//! lanes keep a mask, and the rare lanes that need the scalar code get it one by one.
+
+use glam::{DVec3, Quat, Vec3};
+
+use super::group::LaneGroup;
+use super::simd::{D, DV3, F, M3, Mask, Q, V3};
+use crate::core::inextensible::{self, MAX_NEWTON_ITERATIONS, STAGNATION_LIMIT, TOLERANCE};
+use crate::core::polar::{CONVERGED_ANGLE, MAX_NEWTON_ANGLE, MIN_PIVOT};
+use crate::core::rod::POLAR_ITERATIONS;
+
+/// Advances every lane of `g` by substep `s` of the current step. Returns the lanes whose direct
+/// inextensibility solve failed in some iteration (the scalar fallback ran for them).
+#[inline(always)]
+pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> Mask<L> {
+    let n = g.n;
+    let h = g.h;
+    let (anchor_position, anchor_rotation) = g.anchors[s];
+
+    for k in 0..n - 1 {
+        g.start_bonds[k] = g.x[k + 1] - g.x[k];
+    }
+
+    // Kinematic root.
+    g.p[0] = anchor_position.to_f64() + anchor_rotation.rotate(g.rest_root).to_f64();
+    g.qp[0] = anchor_rotation.mul(g.qbar[0]).normalize();
+
+    // Predict, damping relative to the root.
+    let kick = F::select(g.half_kick, F::splat(0.5 * h), F::splat(h));
+    g.half_kick = Mask([false; L]);
+    let root_velocity = (g.p[0] - g.x[0]).scale(D::splat(1.0 / h as f64)).to_f32();
+    for i in 1..n {
+        let relative = g.v[i] - root_velocity;
+        g.v[i] = root_velocity + relative.scale(g.decay) + g.gravity.scale(kick);
+        g.w[i] = g.w[i].scale(g.decay);
+        g.p[i] = g.x[i] + (g.v[i] * h).to_f64();
+        g.qp[i] = exp_small(g.w[i] * h).mul(g.q[i]).normalize();
+    }
+
+    let iterations = if g.shape_matching { g.iterations.max(1) } else { 1 };
+    let mut fell_back = Mask([false; L]);
+    for _ in 0..iterations {
+        if g.shape_matching {
+            match_shape(g);
+        }
+        let solved = solve_lengths(g);
+        if !solved.0.iter().all(|&ok| ok) {
+            fell_back = fell_back.or(solved.not());
+            fall_back(g, solved);
+        }
+    }
+
+    // Velocities from positions.
+    let inv_h = 1.0 / h;
+    for i in 1..n {
+        g.v[i] = (g.p[i] - g.x[i]).to_f32() * inv_h;
+        g.w[i] = log_small(g.qp[i].mul(g.q[i].conjugate()).align_hemisphere(Q::IDENTITY)) * inv_h;
+        g.x[i] = g.p[i];
+        g.q[i] = g.qp[i];
+    }
+    g.x[0] = g.p[0];
+    g.q[0] = g.qp[0];
+    fell_back
+}
+
+/// One Gauss-Seidel pass over the shape-matching groups, root to tip (see `rod::match_shape`).
+#[inline(always)]
+fn match_shape<const L: usize>(g: &mut LaneGroup<L>) {
+    let n = g.n;
+    let alpha = g.alpha;
+    let alpha64 = alpha.to_f64();
+    let ow = g.orientation_weight;
+
+    // The root's group, clamped to the root.
+    let rotation = g.qp[0].mul(g.qbar_inv[0]).normalize();
+    g.group_rotation[1] = rotation;
+    let centre = g.p[0];
+    for j in 1..n.min(3) {
+        g.p[j] = pull_to_goal(g.p[j], centre, rotation.rotate(g.offsets[1][j]), alpha64);
+    }
+    g.qp[1] = g.qp[1].nlerp_shorter(rotation.mul(g.qbar[1]), alpha);
+
+    let orientation_term = |g: &LaneGroup<L>, j: usize| M3::from_quat(g.qp[j].mul(g.qbar_inv[j])).scale(ow);
+    let mut carried: Option<M3<L>> = None;
+    for i in 2..n {
+        let lo = i - 1;
+        let full = i + 1 < n;
+        let [r_lo, r_mid, r_hi] = g.offsets[i];
+        let m_lo = orientation_term(g, lo);
+        let m_mid = carried.take().unwrap_or_else(|| orientation_term(g, i));
+        let (c, a) = if full {
+            let hi = i + 1;
+            let m_hi = orientation_term(g, hi);
+            carried = Some(m_hi);
+            let c = (DV3::ZERO + g.p[lo] + g.p[i] + g.p[hi]) / 3.0;
+            let a = m_lo
+                .add(M3::outer((g.p[lo] - c).to_f32(), r_lo))
+                .add(m_mid)
+                .add(M3::outer((g.p[i] - c).to_f32(), r_mid))
+                .add(m_hi)
+                .add(M3::outer((g.p[hi] - c).to_f32(), r_hi));
+            (c, a)
+        } else {
+            let c = (DV3::ZERO + g.p[lo] + g.p[i]) / 2.0;
+            let a = m_lo
+                .add(M3::outer((g.p[lo] - c).to_f32(), r_lo))
+                .add(m_mid)
+                .add(M3::outer((g.p[i] - c).to_f32(), r_mid));
+            (c, a)
+        };
+        let mut rotation = g.group_rotation[i];
+        let frame = extract_rotation(&a, &mut rotation);
+        g.group_rotation[i] = rotation;
+        g.p[lo] = pull_to_goal(g.p[lo], c, frame.mul_vec3(r_lo), alpha64);
+        g.p[i] = pull_to_goal(g.p[i], c, frame.mul_vec3(r_mid), alpha64);
+        if full {
+            g.p[i + 1] = pull_to_goal(g.p[i + 1], c, frame.mul_vec3(r_hi), alpha64);
+        }
+        g.qp[i] = g.qp[i].nlerp_shorter(rotation.mul(g.qbar[i]), alpha);
+    }
+}
+
+#[inline(always)]
+fn pull_to_goal<const L: usize>(p: DV3<L>, centre: DV3<L>, offset: V3<L>, alpha: D<L>) -> DV3<L> {
+    let goal = centre + offset.to_f64();
+    p + (goal - p).scale(alpha)
+}
+
+/// `polar::extract_rotation` on every lane; a lane stops changing once it has converged.
+#[inline(always)]
+fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>) -> M3<L> {
+    let norm = (a.x_axis.length_squared() + a.y_axis.length_squared() + a.z_axis.length_squared()).sqrt();
+    let guard = norm * 1e-9 + f32::MIN_POSITIVE;
+    let mut active = Mask([true; L]);
+    for _ in 0..POLAR_ITERATIONS {
+        let r = M3::from_quat(*q);
+        // Columns of `S = R^T A`.
+        let col = |c: V3<L>| V3 { x: r.x_axis.dot(c), y: r.y_axis.dot(c), z: r.z_axis.dot(c) };
+        let s = M3 { x_axis: col(a.x_axis), y_axis: col(a.y_axis), z_axis: col(a.z_axis) };
+        let g = V3 { x: s.y_axis.z - s.z_axis.y, y: s.z_axis.x - s.x_axis.z, z: s.x_axis.y - s.y_axis.x };
+        let trace = s.x_axis.x + s.y_axis.y + s.z_axis.z;
+        let muller = g.scale(F::splat(1.0) / (trace.abs() + guard));
+        let converged = muller.length_squared().lt(F::splat(CONVERGED_ANGLE * CONVERGED_ANGLE));
+        active = active.and(converged.not());
+        if !active.any() {
+            break;
+        }
+        let step = newton_step(&s, g, trace, muller);
+        let turned = q.mul(exp_small(step));
+        *q = Q::select(active, turned.scale(F::splat(1.5) - turned.dot(turned) * 0.5), *q);
+    }
+    M3::from_quat(*q)
+}
+
+/// `polar::newton_step`, or the Müller step `muller` in the lanes where the Newton step is not trusted.
+#[inline(always)]
+fn newton_step<const L: usize>(s: &M3<L>, g: V3<L>, trace: F<L>, muller: V3<L>) -> V3<L> {
+    let (h00, h11, h22) = (trace - s.x_axis.x, trace - s.y_axis.y, trace - s.z_axis.z);
+    let h01 = (s.y_axis.x + s.x_axis.y) * -0.5;
+    let h02 = (s.z_axis.x + s.x_axis.z) * -0.5;
+    let h12 = (s.z_axis.y + s.y_axis.z) * -0.5;
+    let c00 = h11 * h22 - h12 * h12;
+    let c01 = h02 * h12 - h01 * h22;
+    let c02 = h01 * h12 - h02 * h11;
+    let c11 = h00 * h22 - h02 * h02;
+    let c12 = h01 * h02 - h00 * h12;
+    let c22 = h00 * h11 - h01 * h01;
+    let det = h00 * c00 + h01 * c01 + h02 * c02;
+    let pivot = trace.abs() * MIN_PIVOT;
+    let definite = h00.gt(pivot).and(c22.gt(pivot * pivot)).and(det.gt(pivot * pivot * pivot));
+    let inv_det = F::splat(1.0) / det;
+    let step = V3 {
+        x: c00 * g.x + c01 * g.y + c02 * g.z,
+        y: c01 * g.x + c11 * g.y + c12 * g.z,
+        z: c02 * g.x + c12 * g.y + c22 * g.z,
+    }
+    .scale(inv_det);
+    let short = step.length_squared().le(F::splat(MAX_NEWTON_ANGLE * MAX_NEWTON_ANGLE));
+    V3::select(definite.and(short), step, muller)
+}
+
+/// `math::exp_small` on every lane: the series where the turn is short, `Quat::from_scaled_axis` per lane
+/// elsewhere (rare: more than a radian in one substep or solver step).
+#[inline(always)]
+fn exp_small<const L: usize>(e: V3<L>) -> Q<L> {
+    let x2 = e.length_squared() * 0.25;
+    let cos = x2 * (x2 * (x2 * (x2 * (1.0 / 40320.0) + -1.0 / 720.0) + 1.0 / 24.0) + -1.0 / 2.0) + 1.0;
+    let sinc = x2 * (x2 * (x2 * (x2 * (1.0 / 362880.0) + -1.0 / 5040.0) + 1.0 / 120.0) + -1.0 / 6.0) + 1.0;
+    let v = e.scale(sinc * 0.5);
+    let mut q = Q { x: v.x, y: v.y, z: v.z, w: cos };
+    let far = x2.gt(F::splat(0.25));
+    if far.any() {
+        for lane in 0..L {
+            if far.0[lane] {
+                q.set(lane, Quat::from_scaled_axis(Vec3::from_array(e.get(lane))).to_array());
+            }
+        }
+    }
+    q
+}
+
+/// `math::log_small` on every lane, with `Quat::to_scaled_axis` per lane where the series does not apply.
+#[inline(always)]
+fn log_small<const L: usize>(q: Q<L>) -> V3<L> {
+    let v = q.xyz();
+    let s2 = v.length_squared();
+    let inv_w = F::splat(1.0) / q.w;
+    let t2 = s2 * inv_w * inv_w;
+    let atan_t_over_t = t2 * (t2 * (t2 * (t2 * (1.0 / 9.0) + -1.0 / 7.0) + 1.0 / 5.0) + -1.0 / 3.0) + 1.0;
+    let series = v.scale(inv_w * 2.0 * atan_t_over_t);
+    let in_range = q.w.gt(F::splat(0.0)).and(s2.le(q.w * q.w * 0.04)).and(s2.ge(F::splat(1e-16)));
+    let mut r = V3::select(in_range, series, V3::ZERO);
+    let tiny = s2.lt(F::splat(1e-16));
+    let exact = in_range.or(tiny).not();
+    if exact.any() {
+        for lane in 0..L {
+            if exact.0[lane] {
+                r.set(lane, Quat::from_array(q.get(lane)).to_scaled_axis().to_array());
+            }
+        }
+    }
+    r
+}
+
+/// The direct inextensibility solve (`inextensible::newton_along_directions`) on every lane; returns the
+/// lanes where it converged (their `p` holds the result; the others' `p` is untouched).
+#[inline(always)]
+fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>) -> Mask<L> {
+    let m = g.n - 1;
+    let mut active = Mask([true; L]);
+    let mut solved = Mask([false; L]);
+    let mut previous_worst = D::splat(f64::INFINITY);
+    for iteration in 0..MAX_NEWTON_ITERATIONS {
+        let mut pass = ForwardPass::<L>::new();
+        if iteration == 0 {
+            for k in 0..m {
+                let b = g.p[k + 1] - g.p[k];
+                pass.row(k, b, g);
+            }
+        } else {
+            g.corrected[0] = g.p[0];
+            for k in 0..m {
+                g.corrected[k + 1] = g.p[k + 1] + shift(g, k + 1);
+                let b = g.corrected[k + 1] - g.corrected[k];
+                pass.row(k, b, g);
+            }
+        }
+        let converged = active.and(pass.converged(previous_worst));
+        if converged.any() {
+            if iteration > 0 {
+                for j in 1..=m {
+                    g.p[j] = DV3::select(converged, g.corrected[j], g.p[j]);
+                }
+            }
+            solved = solved.or(converged);
+            active = active.and(converged.not());
+        }
+        previous_worst = pass.worst;
+        active = active.and(pass.pivots_usable());
+        if !active.any() {
+            break;
+        }
+        // Back substitution (the Thomas algorithm's pass back), into the multipliers of the active lanes.
+        let mut next = D::splat(0.0);
+        for k in (0..m).rev() {
+            next = g.d_prime[k] - g.c_prime[k] * next;
+            let updated = if iteration == 0 { next } else { g.mu[k] + next };
+            g.mu[k] = D::select(active, updated, g.mu[k]);
+        }
+        active = active.and(next.is_finite());
+        if !active.any() {
+            break;
+        }
+    }
+    solved
+}
+
+/// How far the multipliers move particle `j >= 1` along the start bonds.
+#[inline(always)]
+fn shift<const L: usize>(g: &LaneGroup<L>, j: usize) -> DV3<L> {
+    let m = g.n - 1;
+    let pulled = g.start_bonds[j - 1].scale(g.mu[j - 1]);
+    if j < m { pulled - g.start_bonds[j].scale(g.mu[j]) } else { pulled }
+}
+
+/// `inextensible::ForwardPass` on every lane.
+struct ForwardPass<const L: usize> {
+    worst: D<L>,
+    scale: D<L>,
+    smallest_pivot: D<L>,
+    c_last: D<L>,
+    d_last: D<L>,
+}
+
+impl<const L: usize> ForwardPass<L> {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            worst: D::splat(0.0),
+            scale: D::splat(0.0),
+            smallest_pivot: D::splat(f64::INFINITY),
+            c_last: D::splat(0.0),
+            d_last: D::splat(0.0),
+        }
+    }
+
+    #[inline(always)]
+    fn row(&mut self, k: usize, b: DV3<L>, g: &mut LaneGroup<L>) {
+        let m = g.n - 1;
+        let f = b.length_squared() - g.length_squared[k];
+        let error = (f * g.inverse_length_squared[k]).abs();
+        // As the scalar pass: a NaN error is ignored here.
+        self.worst = D::select(error.gt(self.worst), error, self.worst);
+        let d = &g.start_bonds;
+        let diagonal = if k > 0 { b.dot(d[k]) * 2.0 } else { b.dot(d[k]) };
+        let lower = if k > 0 { -b.dot(d[k - 1]) } else { D::splat(0.0) };
+        let upper = if k + 1 < m { -b.dot(d[k + 1]) } else { D::splat(0.0) };
+        let den = diagonal - lower * self.c_last;
+        let diagonal_size = diagonal.abs();
+        self.scale = D::select(diagonal_size.gt(self.scale), diagonal_size, self.scale);
+        let pivot_size = den.abs();
+        self.smallest_pivot = D::select(pivot_size.lt(self.smallest_pivot), pivot_size, self.smallest_pivot);
+        let inv = D::splat(1.0) / den;
+        self.c_last = upper * inv;
+        self.d_last = (f * -0.5 - lower * self.d_last) * inv;
+        g.c_prime[k] = self.c_last;
+        g.d_prime[k] = self.d_last;
+    }
+
+    #[inline(always)]
+    fn converged(&self, previous_worst: D<L>) -> Mask<L> {
+        let floor = self.worst.gt(previous_worst * 0.5).and(self.worst.lt(D::splat(STAGNATION_LIMIT)));
+        self.worst.le(D::splat(TOLERANCE)).or(floor)
+    }
+
+    #[inline(always)]
+    fn pivots_usable(&self) -> Mask<L> {
+        self.scale.gt(D::splat(0.0)).and(self.smallest_pivot.gt(self.scale * inextensible::MIN_PIVOT))
+    }
+}
+
+/// The scalar fallback for every lane not in `solved`, one lane at a time.
+#[cold]
+fn fall_back<const L: usize>(g: &mut LaneGroup<L>, solved: Mask<L>) {
+    let n = g.n;
+    for lane in 0..L {
+        if solved.0[lane] {
+            continue;
+        }
+        g.lane_p.clear();
+        g.lane_p.extend(g.p[..n].iter().map(|p| DVec3::from_array(p.get(lane))));
+        g.lane_lengths.clear();
+        g.lane_lengths.extend(g.lengths[..n - 1].iter().map(|l| l.0[lane]));
+        inextensible::solve_fallback(&mut g.lane_p, &g.lane_lengths, &mut g.constraints);
+        for (p, solved) in g.p[..n].iter_mut().zip(&g.lane_p) {
+            p.set(lane, solved.to_array());
+        }
+    }
+}

@@ -1,0 +1,201 @@
+//! The lane solver: chains of the same joint count stepped side by side, one chain per SIMD lane.
+//!
+//! Most chains of a character are alike (a head of hair: dozens of strands of one length), and the scalar
+//! solver leaves most of a modern CPU's vector width unused. Here a step sorts the chains it simulates by
+//! joint count, cuts each run of equal length into groups of 8, 4, 2 and 1 chains (so no lane is ever
+//! padding), and advances each group through all of the step's substeps in structure-of-arrays buffers.
+//!
+//! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group; [`group`]: the buffers.
+//! - The wide copies of the kernel are compiled for AVX2 next to the portable (SSE2) one and chosen at run
+//!   time by CPU-feature detection ([`multiversion`]); no build needs `target-cpu=native`.
+//! - Determinism: a chain's result does not depend on its lane, on the group it shares, or on which copy of
+//!   the kernel ran (no fused or reordered floating-point operations): the same bits on every x86-64 and
+//!   aarch64 CPU. It differs from the scalar solver ([`Solver::Scalar`]) by float rounding only (the two
+//!   implement the same operations, grouped differently); `tests/lanes.rs` and the accuracy report measure
+//!   by how much.
+//! - Chains that may touch a collider in a step take the scalar solver for that step (the contact pass is
+//!   scalar); everything else a chain does (sleeping, teleports, momentum suppression, output) is shared.
+
+mod group;
+mod kernel;
+mod simd;
+
+use multiversion::multiversion;
+
+use super::arena::Arena;
+use super::chain::Chain;
+use super::math::Transform;
+use group::{GroupSettings, LaneChain, LaneGroup};
+use simd::Mask;
+
+/// Which solver steps the chains without contacts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Solver {
+    /// Chains of equal joint count side by side in SIMD lanes (the default).
+    #[default]
+    Lanes,
+    /// One chain at a time: the reference implementation (and what chains near colliders always use).
+    Scalar,
+}
+
+/// The instruction set the lane solver's kernel runs with on this CPU: `"avx2"`, `"sse2"` (the portable
+/// x86-64 build), `"neon"` (aarch64) or `"scalar"`.
+pub fn simd_path() -> &'static str {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx2") { "avx2" } else { "sse2" }
+    }
+    #[cfg(target_arch = "aarch64")]
+    {
+        "neon"
+    }
+    #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
+    {
+        "scalar"
+    }
+}
+
+/// One chain the step hands to the lane solver, with its per-step constants (computed like the scalar
+/// solver's inputs).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LaneJob {
+    pub slot: u32,
+    pub joints: usize,
+    /// The anchor at the start and at the end of the step (relative to the engine origin).
+    pub start: Transform,
+    pub target: Transform,
+    pub alpha_per_iteration: f32,
+    pub velocity_decay: f32,
+    pub gravity: glam::Vec3,
+    pub orientation_weight: f32,
+    /// Nothing about the chain changed this step (towards sleeping).
+    pub still: bool,
+}
+
+impl LaneJob {
+    fn key(&self) -> (usize, bool) {
+        (self.joints, self.alpha_per_iteration > 0.0)
+    }
+}
+
+/// The timing of one step, shared by every chain.
+pub(crate) struct Clock<'a> {
+    pub h: f32,
+    pub iterations: u32,
+    /// Fraction of the step's anchor motion reached at the end of each substep.
+    pub progress: &'a [f32],
+}
+
+/// The lane solver's reusable buffers (one group of each width).
+#[derive(Default)]
+pub struct LaneSolver {
+    g8: LaneGroup<8>,
+    g4: LaneGroup<4>,
+    g2: LaneGroup<2>,
+    g1: LaneGroup<1>,
+}
+
+impl LaneSolver {
+    /// Runs every substep of the step for the chains of `jobs` (reordered by joint count). Returns the
+    /// substeps, summed over the chains, in which the direct inextensibility solve fell back.
+    pub(crate) fn step(&mut self, chains: &mut Arena<Chain>, jobs: &mut [LaneJob], clock: &Clock<'_>) -> u64 {
+        jobs.sort_unstable_by_key(|j| (j.key(), j.slot));
+        let mut fallbacks = 0;
+        let mut rest = &jobs[..];
+        while let Some(first) = rest.first() {
+            let same = rest.iter().take_while(|j| j.key() == first.key()).count();
+            let (mut run, tail) = rest.split_at(same);
+            rest = tail;
+            while !run.is_empty() {
+                let (group, remaining) = run.split_at(match run.len() {
+                    8.. => 8,
+                    4.. => 4,
+                    2.. => 2,
+                    _ => 1,
+                });
+                run = remaining;
+                fallbacks += match group.len() {
+                    8 => run_group(&mut self.g8, chains, group, clock, substep8),
+                    4 => run_group(&mut self.g4, chains, group, clock, substep4),
+                    2 => run_group(&mut self.g2, chains, group, clock, substep2),
+                    _ => run_group(&mut self.g1, chains, group, clock, kernel::substep::<1>),
+                };
+            }
+        }
+        fallbacks
+    }
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn substep8(g: &mut LaneGroup<8>, s: usize) -> Mask<8> {
+    kernel::substep(g, s)
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn substep4(g: &mut LaneGroup<4>, s: usize) -> Mask<4> {
+    kernel::substep(g, s)
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn substep2(g: &mut LaneGroup<2>, s: usize) -> Mask<2> {
+    kernel::substep(g, s)
+}
+
+fn run_group<const L: usize>(
+    g: &mut LaneGroup<L>,
+    chains: &mut Arena<Chain>,
+    jobs: &[LaneJob],
+    clock: &Clock<'_>,
+    substep: fn(&mut LaneGroup<L>, usize) -> Mask<L>,
+) -> u64 {
+    debug_assert_eq!(jobs.len(), L);
+    let substeps = clock.progress.len();
+    let first = &jobs[0];
+    g.begin(GroupSettings {
+        joints: first.joints,
+        h: clock.h,
+        iterations: clock.iterations,
+        shape_matching: first.alpha_per_iteration > 0.0,
+        substeps,
+    });
+    let anchor = |job: &LaneJob, s: usize| job.start.interpolate(&job.target, clock.progress[s]);
+    for (lane, job) in jobs.iter().enumerate() {
+        let chain = chains.at(job.slot as usize).expect("live");
+        g.load(
+            lane,
+            &LaneChain {
+                state: &chain.state,
+                rest: &chain.rest,
+                offsets: &chain.rest_groups.offsets,
+                lengths: &chain.frame.lengths,
+                alpha_per_iteration: job.alpha_per_iteration,
+                velocity_decay: job.velocity_decay,
+                gravity: job.gravity,
+                orientation_weight: job.orientation_weight,
+                half_kick: chain.half_kick,
+            },
+        );
+        for s in 0..substeps {
+            g.set_anchor(s, lane, &anchor(job, s));
+        }
+    }
+    let mut fallbacks = 0;
+    for s in 0..substeps {
+        let fell_back = substep(g, s);
+        fallbacks += fell_back.0.iter().filter(|&&f| f).count() as u64;
+        // The render interpolation keeps the last two internal poses.
+        if s + 2 >= substeps {
+            for (lane, job) in jobs.iter().enumerate() {
+                let chain = chains.at_mut(job.slot as usize).expect("live");
+                g.store_pose(lane, &mut chain.state);
+                chain.capture_local(&anchor(job, s));
+            }
+        }
+    }
+    for (lane, job) in jobs.iter().enumerate() {
+        let chain = chains.at_mut(job.slot as usize).expect("live");
+        g.store(lane, &mut chain.state);
+        chain.half_kick = false;
+    }
+    fallbacks
+}

@@ -1,0 +1,151 @@
+//! The lane solver (chains side by side in SIMD lanes) against the scalar reference solver, and its
+//! determinism policy: a chain's result does not depend on its lane, its group or the kernel copy that ran.
+
+mod common;
+
+use common::*;
+use glam::{Quat, Vec3};
+use kodawari::{ChainId, ChainParams, Engine, EngineSettings, Solver, Transform};
+
+const HEAD: Vec3 = Vec3::new(0.0, 1.6, 0.0);
+
+/// The head sways and turns, the camera orbits: every chain bends, turns and re-blends its rest shape.
+fn head(frame: usize) -> Transform {
+    let t = frame as f32 / 60.0;
+    Transform::new(
+        HEAD + Vec3::new(0.15 * (5.0 * t).sin(), 0.05 * (7.0 * t).sin(), 0.1 * (3.0 * t).cos()),
+        Quat::from_rotation_y(0.6 * (2.0 * t).sin()) * Quat::from_rotation_x(0.3 * (3.0 * t).sin()),
+    )
+}
+
+fn drive(engine: &mut Engine, frames: std::ops::Range<usize>) {
+    for frame in frames {
+        let camera = orbit_camera(HEAD, 3.0, frame as f32 * 0.05);
+        engine.step(1.0 / 60.0, camera, head(frame)).unwrap();
+    }
+}
+
+struct Strand {
+    joints: usize,
+    params: ChainParams,
+    views: bool,
+}
+
+/// Chains of every kind the lane solver groups: lengths 2 to 20 (several of each, so groups of 8, 4, 2 and 1
+/// form), limp, soft, stiff and rigid, with and without view shapes.
+fn strands() -> Vec<Strand> {
+    let mut strands = Vec::new();
+    for (i, joints) in
+        [2usize, 3, 5, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 12, 12, 12, 16, 16, 16, 16, 16, 20].iter().enumerate()
+    {
+        let stiffness = [0.0, 0.3, 0.5, 0.8, 1.0][i % 5];
+        let params = ChainParams {
+            stiffness,
+            damping: 0.5 + (i % 3) as f32,
+            radius: 0.01 + 0.002 * i as f32,
+            ..Default::default()
+        };
+        strands.push(Strand { joints: *joints, params, views: i % 2 == 0 });
+    }
+    strands
+}
+
+fn build(solver: Solver, strands: &[Strand]) -> (Engine, Vec<(ChainId, f32)>) {
+    let mut engine = Engine::new(EngineSettings::default()).unwrap();
+    engine.set_solver(solver);
+    let mut ids = Vec::new();
+    for (i, s) in strands.iter().enumerate() {
+        let angle = i as f32 * 0.7;
+        let direction = Vec3::new(angle.cos(), 0.4, angle.sin());
+        let base = curled_chain(s.joints, Vec3::new(0.0, 0.1, 0.0), direction, Vec3::Y, 0.2, 0.03);
+        let id = engine.create_chain(s.params, &base).unwrap();
+        if s.views {
+            let view = curled_chain(s.joints, Vec3::new(0.0, 0.1, 0.0), direction, Vec3::X, -0.4, 0.03);
+            engine.add_view_shape(id, Vec3::X, &view, 2.0).unwrap();
+        }
+        ids.push((id, chain_length(&base)));
+    }
+    (engine, ids)
+}
+
+/// Largest distance between the two engines' joints, per chain length, over `frames`, checked every frame.
+fn largest_difference(strands: &[Strand], frames: usize) -> f32 {
+    let (mut lanes, ids) = build(Solver::Lanes, strands);
+    let (mut scalar, scalar_ids) = build(Solver::Scalar, strands);
+    let mut worst = 0.0f32;
+    for frame in 0..frames {
+        drive(&mut lanes, frame..frame + 1);
+        drive(&mut scalar, frame..frame + 1);
+        for (&(id, length), &(scalar_id, _)) in ids.iter().zip(&scalar_ids) {
+            let (a, b) = (chain_world(&lanes, id), chain_world(&scalar, scalar_id));
+            for (x, y) in a.iter().zip(&b) {
+                worst = worst.max((x.position - y.position).length() / length);
+            }
+        }
+    }
+    worst
+}
+
+/// The two solvers implement the same operations; they differ by float rounding, which the motion amplifies
+/// only slowly over a second of strong swaying (the limp chains are chaotic n-pendulums).
+#[test]
+fn lane_solver_matches_the_scalar_solver() {
+    let strands = strands();
+    let worst = largest_difference(&strands, 60);
+    println!("lane vs scalar solver, 1 s of swaying, 23 chains: largest joint distance {worst:.2e} chain lengths");
+    assert!(worst <= 1e-4, "{worst}");
+}
+
+/// A chain's particles in the latest internal state, as bits.
+fn particle_bits(engine: &Engine, id: ChainId) -> Vec<[u32; 3]> {
+    let mut bits = Vec::new();
+    engine.for_each_chain_particle(id, |x| bits.push(x.to_array().map(f32::to_bits))).unwrap();
+    bits
+}
+
+/// The determinism policy: the same chain simulated alone (a group of one, the portable kernel) and with 12
+/// other chains of its length around it (in a group of 8 on the AVX2 kernel where the CPU has it, at every
+/// lane position) moves identically to the bit.
+#[test]
+fn a_chains_motion_does_not_depend_on_its_lane_or_group() {
+    let subject = Strand { joints: 10, params: ChainParams { stiffness: 0.6, ..Default::default() }, views: true };
+    let (mut alone, ids) = build(Solver::Lanes, &[subject]);
+    drive(&mut alone, 0..90);
+    let reference = particle_bits(&alone, ids[0].0);
+    let reference_pose = chain_world(&alone, ids[0].0);
+    for position in [0usize, 3, 7, 12] {
+        let mut strands: Vec<Strand> = (0..13)
+            .map(|i| Strand {
+                joints: 10,
+                params: ChainParams { stiffness: 0.2 + 0.05 * i as f32, damping: i as f32, ..Default::default() },
+                views: i % 3 == 0,
+            })
+            .collect();
+        strands[position] =
+            Strand { joints: 10, params: ChainParams { stiffness: 0.6, ..Default::default() }, views: true };
+        // Each neighbour gets its own rest direction from its index; the subject must get the one it had alone.
+        let (mut crowd, ids) = build_with_subject_at(&strands, position);
+        drive(&mut crowd, 0..90);
+        assert_eq!(particle_bits(&crowd, ids[position].0), reference, "subject in lane position {position}");
+        assert_eq!(chain_world(&crowd, ids[position].0), reference_pose);
+    }
+    println!("lane solver kernel: {}", kodawari::simd_path());
+}
+
+/// [`build`], except that the chain at `subject` gets the rest shape of chain 0 of a one-chain engine.
+fn build_with_subject_at(strands: &[Strand], subject: usize) -> (Engine, Vec<(ChainId, f32)>) {
+    let mut engine = Engine::new(EngineSettings::default()).unwrap();
+    let mut ids = Vec::new();
+    for (i, s) in strands.iter().enumerate() {
+        let angle = if i == subject { 0.0 } else { i as f32 * 0.7 };
+        let direction = Vec3::new(angle.cos(), 0.4, angle.sin());
+        let base = curled_chain(s.joints, Vec3::new(0.0, 0.1, 0.0), direction, Vec3::Y, 0.2, 0.03);
+        let id = engine.create_chain(s.params, &base).unwrap();
+        if s.views {
+            let view = curled_chain(s.joints, Vec3::new(0.0, 0.1, 0.0), direction, Vec3::X, -0.4, 0.03);
+            engine.add_view_shape(id, Vec3::X, &view, 2.0).unwrap();
+        }
+        ids.push((id, chain_length(&base)));
+    }
+    (engine, ids)
+}

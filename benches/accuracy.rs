@@ -16,13 +16,14 @@ mod pendulum;
 #[path = "support/plot.rs"]
 mod plot;
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::hint::black_box;
 use std::time::Instant;
 
 use glam::{DVec3, Quat, Vec3};
-use kodawari::{ChainId, ChainParams, Engine, EngineSettings, Transform};
+use kodawari::{ChainId, ChainParams, Engine, EngineSettings, Solver, Transform};
 use pendulum::{Pendulum, Tolerance};
 
 const HEAD: Vec3 = Vec3::new(0.0, 1.6, 0.0);
@@ -69,7 +70,14 @@ fn lengths_of(joints: &[Transform]) -> Vec<f64> {
 fn world(engine: &Engine, id: ChainId) -> Vec<DVec3> {
     let mut out = vec![Transform::IDENTITY; engine.chain_joint_count(id).unwrap()];
     engine.read_chain_world(id, &mut out).unwrap();
-    out.iter().map(|t| t.position.as_dvec3()).collect()
+    let positions: Vec<DVec3> = out.iter().map(|t| t.position.as_dvec3()).collect();
+    TRACE.with(|trace| {
+        if let Some(trace) = trace.borrow_mut().as_mut() {
+            let run = CONTEXT.with(|c| c.borrow().clone());
+            trace.entry(run).or_default().push(positions.clone());
+        }
+    });
+    positions
 }
 
 /// Largest relative deviation of any segment of `positions` from `lengths`.
@@ -78,10 +86,29 @@ fn stretch(positions: &[DVec3], lengths: &[f64]) -> f64 {
 }
 
 thread_local! {
-    /// What is running now, for the solver-fallback log.
+    /// What is running now, for the solver-fallback log (and the solver comparison's trajectories).
     static CONTEXT: RefCell<String> = const { RefCell::new(String::new()) };
     /// (run, substeps where the direct inextensibility solve fell back).
     static FALLBACKS: RefCell<Vec<(String, u64)>> = const { RefCell::new(Vec::new()) };
+    /// The solver every engine is built with; `None`: the engine's default (the lane solver). Only the solver
+    /// comparison sets it.
+    static SOLVER: Cell<Option<Solver>> = const { Cell::new(None) };
+    /// Whether `wall_per_sim_second` times its run (the solver comparison re-runs the scenarios untimed).
+    static TIMED: Cell<bool> = const { Cell::new(true) };
+    /// When set, every `world` read-back is recorded here under the running context (solver comparison).
+    static TRACE: RefCell<Option<Trace>> = const { RefCell::new(None) };
+}
+
+/// Every read-back of a set of runs: per run (context), the joint positions of each frame, in order.
+type Trace = BTreeMap<String, Vec<Vec<DVec3>>>;
+
+/// An engine at `settings` with the solver of this run (see `SOLVER`).
+fn new_engine(settings: EngineSettings) -> Engine {
+    let mut engine = Engine::new(settings).unwrap();
+    if let Some(solver) = SOLVER.with(Cell::get) {
+        engine.set_solver(solver);
+    }
+    engine
 }
 
 fn context(name: String) {
@@ -116,7 +143,11 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Median wall time per simulated second of `run`, which builds its scene untimed and returns the seconds
 /// its stepping (with a read-back every frame, as a host does) took.
+/// NaN (and `run` never called) while the solver comparison re-runs the scenarios untimed.
 fn wall_per_sim_second(sim_seconds: f64, mut run: impl FnMut() -> f64) -> f64 {
+    if !TIMED.with(Cell::get) {
+        return f64::NAN;
+    }
     let once = run().max(1e-7);
     let inner = ((MIN_SAMPLE / once).ceil() as usize).clamp(1, 10_000);
     let samples = (0..REPEATS).map(|_| (0..inner).map(|_| run()).sum::<f64>() / inner as f64).collect();
@@ -178,9 +209,11 @@ struct Stretch {
 #[derive(Default)]
 struct Report {
     figures: Vec<Figure>,
-    /// Free-form sections for the markdown, printed as they are produced.
+    /// Free-form sections for the markdown, printed as they are produced (unless `quiet`).
     sections: Vec<String>,
     stretch: Vec<Stretch>,
+    /// A re-run for the solver comparison: its sections are kept but not printed.
+    quiet: bool,
 }
 
 impl Report {
@@ -189,7 +222,9 @@ impl Report {
     }
 
     fn section(&mut self, text: String) {
-        println!("{text}");
+        if !self.quiet {
+            println!("{text}");
+        }
         self.sections.push(text);
     }
 
@@ -271,7 +306,7 @@ fn pendulum_run(reference: &PendulumReference, fps: u32, settings: EngineSetting
         settings.effective_substep_rate(),
         settings.effective_iterations()
     ));
-    let mut engine = Engine::new(settings).unwrap();
+    let mut engine = new_engine(settings);
     let base = reference.base();
     let lengths = lengths_of(&base);
     let id = engine.create_chain(limp(), &base).unwrap();
@@ -305,7 +340,7 @@ fn pendulum_run(reference: &PendulumReference, fps: u32, settings: EngineSetting
 }
 
 fn pendulum_timed(reference: &PendulumReference, fps: u32, settings: EngineSettings) -> f64 {
-    let mut engine = Engine::new(settings).unwrap();
+    let mut engine = new_engine(settings);
     let id = engine.create_chain(limp(), &reference.base()).unwrap();
     let frames = (PENDULUM_SECONDS * fps as f64).round() as u32;
     let mut out = vec![Transform::IDENTITY; reference.joints];
@@ -435,7 +470,7 @@ fn sway_run(
 ) -> (Vec<(f64, DVec3)>, f64) {
     let base = sway_base();
     let lengths = lengths_of(&base);
-    let mut engine = Engine::new(settings).unwrap();
+    let mut engine = new_engine(settings);
     let id = engine.create_chain(params, &base).unwrap();
     let mut t = 0.0;
     let mut tips = Vec::with_capacity(dts.len());
@@ -598,7 +633,7 @@ fn settle_scenes() -> Vec<SettleScene> {
 fn settle(scene: &SettleScene, settings: EngineSettings, root: impl Fn(f64) -> Transform) -> (Vec<DVec3>, f64, f64) {
     let lengths = lengths_of(&scene.base);
     let length: f64 = lengths.iter().sum();
-    let mut engine = Engine::new(settings).unwrap();
+    let mut engine = new_engine(settings);
     let id = engine.create_chain(scene.params, &scene.base).unwrap();
     let fps = 60u32;
     let frames = (scene.seconds * fps as f64).round() as u32;
@@ -763,7 +798,7 @@ fn rest_fidelity(report: &mut Report) {
     let lengths = lengths_of(&base);
     let length: f64 = lengths.iter().sum();
     let build = || {
-        let mut engine = Engine::new(settings).unwrap();
+        let mut engine = new_engine(settings);
         let id = engine.create_chain(ChainParams::default(), &base).unwrap();
         engine.add_view_shape(id, -Vec3::X, &left, 1.0).unwrap();
         engine.add_view_shape(id, Vec3::X, &right, 2.0).unwrap();
@@ -831,7 +866,7 @@ fn orbit(stiffness: f32, suppression: f32) -> OrbitResult {
     let lengths = lengths_of(&base);
     let length: f64 = lengths.iter().sum();
     let settings = EngineSettings { gravity: Vec3::ZERO, ..Default::default() };
-    let mut engine = Engine::new(settings).unwrap();
+    let mut engine = new_engine(settings);
     let params = ChainParams { stiffness, momentum_suppression: suppression, damping: 0.0, ..Default::default() };
     let id = engine.create_chain(params, &base).unwrap();
     engine.add_view_shape(id, -Vec3::X, &left, 1.0).unwrap();
@@ -1002,7 +1037,7 @@ fn sweep(report: &mut Report, references: &[PendulumReference]) -> Vec<SweepRow>
                 .sum();
             let error = (sum / tips.len() as f64).sqrt();
             let wall = wall_per_sim_second(SWAY_SECONDS, || {
-                let mut engine = Engine::new(settings).unwrap();
+                let mut engine = new_engine(settings);
                 let id = engine.create_chain(params, &sway_base()).unwrap();
                 let mut out = [Transform::IDENTITY; 9];
                 let start = Instant::now();
@@ -1106,6 +1141,193 @@ fn unique(items: impl Iterator<Item = String>) -> Vec<String> {
     out
 }
 
+// ---- lane solver vs scalar solver ---------------------------------------------------------------------
+
+/// One solver's pass over every scenario with default-settings figures (untimed): its figures and stretch,
+/// its solver-fallback log, and every read-back per scenario family.
+struct SolverPass {
+    report: Report,
+    fallbacks: Vec<(String, u64)>,
+    traces: Vec<(&'static str, Trace)>,
+}
+
+fn solver_pass(solver: Solver, references: &[PendulumReference]) -> SolverPass {
+    let main_fallbacks = FALLBACKS.take();
+    SOLVER.set(Some(solver));
+    TIMED.set(false);
+    let mut report = Report { quiet: true, ..Default::default() };
+    type Scenarios<'a> = &'a dyn Fn(&mut Report);
+    let families: [(&'static str, Scenarios); 6] = [
+        ("n-pendulum, 30/60/120/240 fps", &|r| pendulums(r, references)),
+        ("frame-rate invariance (every frame rate and its input-matched 960 fps run)", &frame_rate_invariance),
+        ("settled shapes (default, and 120-960 Hz x 1-8 iterations)", &settled_shapes),
+        ("Galilean invariance and spinning root", &galilean),
+        ("rest fidelity", &rest_fidelity),
+        ("momentum suppression (orbit, on and off, 5 stiffnesses)", &momentum_suppression),
+    ];
+    let mut traces = Vec::new();
+    for (family, run) in families {
+        TRACE.set(Some(Trace::new()));
+        run(&mut report);
+        traces.push((family, TRACE.take().unwrap_or_default()));
+    }
+    SOLVER.set(None);
+    TIMED.set(true);
+    let fallbacks = FALLBACKS.replace(main_fallbacks);
+    SolverPass { report, fallbacks, traces }
+}
+
+/// |a - b| relative to the larger magnitude (0 when both are 0).
+fn relative_difference(a: f64, b: f64) -> f64 {
+    let scale = a.abs().max(b.abs());
+    if scale == 0.0 { 0.0 } else { (a - b).abs() / scale }
+}
+
+/// Largest joint distance between two recordings of the same run, per frame, / the chain's length (from
+/// the first frame).
+fn trajectory_difference(a: &[Vec<DVec3>], b: &[Vec<DVec3>]) -> f64 {
+    assert_eq!(a.len(), b.len(), "both solvers read back the same frames");
+    let Some(first) = a.first() else { return 0.0 };
+    let length: f64 = first.windows(2).map(|w| (w[1] - w[0]).length()).sum();
+    let worst = a.iter().zip(b).flat_map(|(x, y)| x.iter().zip(y).map(|(p, q)| (*p - *q).length())).fold(0.0, f64::max);
+    worst / length
+}
+
+/// Every default-settings scenario re-run (untimed) once with each solver: the figures of the summary
+/// table side by side, and how far the two solvers' trajectories are apart.
+fn solver_comparison(main: &Report, references: &[PendulumReference]) -> String {
+    let started = Instant::now();
+    let lanes = solver_pass(Solver::Lanes, references);
+    let scalar = solver_pass(Solver::Scalar, references);
+    let mut text = format!(
+        "## Lane solver vs scalar solver\n\nThe tables above use the default solver, `Solver::Lanes` (chains of equal joint count stepped side by side in SIMD lanes; a single chain runs in a group of one lane; kernel here: {}). Below, every scenario with a default-settings figure is run once more with `Engine::set_solver(Solver::Lanes)` and once with `Solver::Scalar` (the one-chain-at-a-time reference solver), untimed; the level-of-detail and run-time sweeps are not repeated. The two solvers implement the same operations grouped differently, so they should differ by float rounding only. No scenario here has colliders (chains near colliders always take the scalar solver).\n\n",
+        kodawari::simd_path()
+    );
+    let same_as_main = lanes.report.figures.iter().all(|f| {
+        main.figures
+            .iter()
+            .any(|m| m.scenario == f.scenario && m.figure == f.figure && m.value.to_bits() == f.value.to_bits())
+    });
+    let _ = writeln!(
+        text,
+        "The lane-solver column reproduces the default-settings table above {}.\n",
+        if same_as_main {
+            "bit for bit"
+        } else {
+            "NOT bit for bit (the default solver is not the lane solver, or a run is not deterministic)"
+        }
+    );
+    text.push_str("| scenario | figure | lane solver | scalar solver | abs. difference | relative difference |\n|---|---|---|---|---|---|\n");
+    assert_eq!(lanes.report.figures.len(), scalar.report.figures.len(), "both passes report the same figures");
+    let (mut worst_relative, mut worst_absolute) = ((0.0f64, String::new()), (0.0f64, String::new()));
+    for (l, s) in lanes.report.figures.iter().zip(&scalar.report.figures) {
+        assert!(l.scenario == s.scenario && l.figure == s.figure, "both passes report the same figures in order");
+        let relative = relative_difference(l.value, s.value);
+        if relative > worst_relative.0 {
+            worst_relative = (relative, format!("{}: {}", l.scenario, l.figure));
+        }
+        if (l.value - s.value).abs() > worst_absolute.0 {
+            worst_absolute = ((l.value - s.value).abs(), format!("{}: {}", l.scenario, l.figure));
+        }
+        let _ = writeln!(
+            text,
+            "| {} | {} | {:.4e} | {:.4e} | {:.2e} | {relative:.1e} |",
+            l.scenario,
+            l.figure,
+            l.value,
+            s.value,
+            (l.value - s.value).abs()
+        );
+    }
+    for (what, _, filter) in stretch_rows() {
+        // The third row here covers the settled-shape grid only (the sweeps are not repeated).
+        let what = what.replace("of the sweeps", "of the settled-shape grid");
+        let ((lane_run, l), (scalar_run, s)) =
+            (worst_stretch(&lanes.report, filter), worst_stretch(&scalar.report, filter));
+        let runs = if lane_run == scalar_run {
+            format!("worst: {lane_run}")
+        } else {
+            format!("worst: {lane_run} / {scalar_run}")
+        };
+        let _ = writeln!(
+            text,
+            "| inextensibility | {what}; {runs} | {l:.4e} | {s:.4e} | {:.2e} | {:.1e} |",
+            (l - s).abs(),
+            relative_difference(l, s)
+        );
+    }
+    let total = |f: &[(String, u64)]| f.iter().map(|(_, n)| n).sum::<u64>();
+    let _ = writeln!(
+        text,
+        "| inextensibility solver fallbacks | substeps over every run above | {} | {} | {} | |",
+        total(&lanes.fallbacks),
+        total(&scalar.fallbacks),
+        total(&lanes.fallbacks).abs_diff(total(&scalar.fallbacks))
+    );
+    let _ = writeln!(
+        text,
+        "\nLargest absolute difference of a figure: {:.2e} ({}); largest relative difference: {:.1e} ({}). A large \
+         relative difference with a small absolute one marks a figure that is itself at the level of float \
+         rounding (the input-matched and 240 fps frame-rate rows, rest fidelity, the stiffness-1 residual energy): \
+         there the two solvers' rounding differences are the whole figure.\n",
+        worst_absolute.0, worst_absolute.1, worst_relative.0, worst_relative.1
+    );
+    text.push_str("Trajectories: every read-back of every run above, lane solver against scalar solver: the largest distance of any joint at any frame / chain length.\n\n| scenarios | runs (by name) | read-backs | largest joint difference / length | in run | median over runs of each run's largest |\n|---|---|---|---|---|---|\n");
+    for ((family, a), (_, b)) in lanes.traces.iter().zip(&scalar.traces) {
+        let mut per_run: Vec<(f64, &str, usize)> = a
+            .iter()
+            .map(|(run, frames)| {
+                let other = b.get(run).expect("both solvers ran the same runs");
+                (trajectory_difference(frames, other), run.as_str(), frames.len())
+            })
+            .collect();
+        let frames: usize = per_run.iter().map(|r| r.2).sum();
+        per_run.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let Some(&(worst, worst_run, _)) = per_run.last() else { continue };
+        let median_run = median(per_run.iter().map(|r| r.0).collect());
+        let worst_run = if worst == 0.0 { "(every run bit for bit the same)" } else { worst_run };
+        let _ = writeln!(
+            text,
+            "| {family} | {} | {frames} | {worst:.2e} | {worst_run} | {median_run:.2e} |",
+            per_run.len()
+        );
+    }
+    text.push_str(&solver_costs(references));
+    let _ = writeln!(text, "\n(This section's runs took {:.1} s.)", started.elapsed().as_secs_f64());
+    text
+}
+
+/// Wall time per simulated second of the pendulums at 60 fps (default settings) with each solver, timed
+/// alternately (lanes, scalar, then scalar, lanes, ...) so a change of load hits both alike.
+fn solver_costs(references: &[PendulumReference]) -> String {
+    const ROUNDS: usize = 4;
+    let mut text = format!(
+        "\nCost of a single chain (the pendulums at 60 fps, default settings, one engine with one chain: the lane solver runs it as a group of one lane): wall s / sim s, the best of {ROUNDS} alternating timings per solver (each the median of {REPEATS} repetitions).\n\n| scenario | lane solver | scalar solver | lanes / scalar |\n|---|---|---|---|\n"
+    );
+    for reference in references {
+        let mut best = [f64::INFINITY; 2];
+        for round in 0..ROUNDS {
+            for k in 0..2 {
+                let i = if round % 2 == 0 { k } else { 1 - k };
+                SOLVER.set(Some([Solver::Lanes, Solver::Scalar][i]));
+                let cost =
+                    wall_per_sim_second(PENDULUM_SECONDS, || pendulum_timed(reference, 60, EngineSettings::default()));
+                best[i] = best[i].min(cost);
+            }
+        }
+        SOLVER.set(None);
+        let _ = writeln!(
+            text,
+            "| {} | {:.2e} | {:.2e} | {:.2} |",
+            pendulum_name(reference.joints),
+            best[0],
+            best[1],
+            best[0] / best[1]
+        );
+    }
+    text
+}
+
 // ---- output -------------------------------------------------------------------------------------------
 
 fn write_csv(path: &str, rows: &[SweepRow]) -> std::io::Result<()> {
@@ -1129,19 +1351,12 @@ fn write_csv(path: &str, rows: &[SweepRow]) -> std::io::Result<()> {
     std::fs::write(path, csv)
 }
 
-fn summary_table(report: &Report) -> String {
-    let mut text = String::from(
-        "## Default settings: every figure\n\nDefault engine settings (240 Hz substeps, 2 iterations), 60 fps unless the figure says otherwise. Errors are / chain length. Cost: wall-clock seconds per simulated second (median, one thread, this 2-core machine), where measured.\n\n| scenario | figure | value | cost s/s | bar | verdict |\n|---|---|---|---|---|---|\n",
-    );
-    for f in &report.figures {
-        let cost = f.cost.map(|c| format!("{c:.2e}")).unwrap_or_default();
-        let bar = f.bar.map(|b| format!("<= {:.0e} ({})", b.limit, b.source)).unwrap_or_default();
-        let _ =
-            writeln!(text, "| {} | {} | {:.2e} | {cost} | {bar} | {} |", f.scenario, f.figure, f.value, f.verdict());
-    }
+type StretchFilter = fn(&Stretch) -> bool;
+
+/// The inextensibility rows of the summary: (what, bar, which runs).
+fn stretch_rows() -> [(&'static str, &'static str, StretchFilter); 3] {
     let bar = "<= 1e-4 (SPEC 6.1, issue 4)";
-    type Filter = fn(&Stretch) -> bool;
-    let rows: [(&str, &str, Filter); 3] = [
+    [
         (
             "max relative segment stretch, every frame of every default-settings run above that lands on an internal state",
             bar,
@@ -1155,10 +1370,27 @@ fn summary_table(report: &Report) -> String {
         ("same, every (substep rate, iterations) setting of the sweeps, frames on internal states", "", |s| {
             !s.interpolated
         }),
-    ];
-    for (what, bar, filter) in rows {
-        let worst = report.stretch.iter().filter(|s| filter(s)).max_by(|a, b| a.value.total_cmp(&b.value));
-        let (name, value) = worst.map(|s| (s.run.as_str(), s.value)).unwrap_or(("", 0.0));
+    ]
+}
+
+/// The run with the largest stretch among those `filter` selects: (run, stretch); ("", 0) if none.
+fn worst_stretch(report: &Report, filter: StretchFilter) -> (&str, f64) {
+    let worst = report.stretch.iter().filter(|s| filter(s)).max_by(|a, b| a.value.total_cmp(&b.value));
+    worst.map(|s| (s.run.as_str(), s.value)).unwrap_or(("", 0.0))
+}
+
+fn summary_table(report: &Report) -> String {
+    let mut text = String::from(
+        "## Default settings: every figure\n\nDefault engine settings (240 Hz substeps, 2 iterations), 60 fps unless the figure says otherwise. Errors are / chain length. Cost: wall-clock seconds per simulated second (median, one thread, this 2-core machine), where measured.\n\n| scenario | figure | value | cost s/s | bar | verdict |\n|---|---|---|---|---|---|\n",
+    );
+    for f in &report.figures {
+        let cost = f.cost.map(|c| format!("{c:.2e}")).unwrap_or_default();
+        let bar = f.bar.map(|b| format!("<= {:.0e} ({})", b.limit, b.source)).unwrap_or_default();
+        let _ =
+            writeln!(text, "| {} | {} | {:.2e} | {cost} | {bar} | {} |", f.scenario, f.figure, f.value, f.verdict());
+    }
+    for (what, bar, filter) in stretch_rows() {
+        let (name, value) = worst_stretch(report, filter);
         let verdict = match (bar.is_empty(), value <= 1e-4) {
             (true, _) => "report",
             (false, true) => "met",
@@ -1198,6 +1430,8 @@ fn main() {
         }
     }
     println!("{fallback_text}");
+    let comparison = solver_comparison(&report, &references);
+    println!("{comparison}");
 
     write_csv(&format!("{docs}/accuracy.csv"), &rows).expect("write docs/accuracy.csv");
     let series: Vec<plot::Series> = unique(rows.iter().map(|r| r.scenario.clone()))
@@ -1224,6 +1458,8 @@ fn main() {
     md.push_str(&summary);
     md.push('\n');
     md.push_str(&fallback_text);
+    md.push('\n');
+    md.push_str(&comparison);
     md.push('\n');
     for s in &report.sections {
         md.push_str(s);

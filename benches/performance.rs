@@ -1,15 +1,17 @@
 //! Performance evidence (SPEC 6.3): cost per joint per internal substep and per 60 Hz frame on named scenes,
-//! what each skip of SPEC 3.8 saves, the C ABI's overhead, linearity in the joint count, and rapier3d side by
-//! side on the same scenes and on the accuracy benchmark's pendulums.
+//! what each skip of SPEC 3.8 saves, the lane solver against the scalar solver, the C ABI's overhead,
+//! linearity in the joint count, and rapier3d side by side on the same scenes and on the accuracy benchmark's
+//! pendulums.
 //!
 //! `cargo bench --bench performance --features peers` runs it all (criterion groups, then interleaved
 //! ratio measurements) and writes `docs/performance.md`. Without `--features peers` the rapier3d rows say the
 //! peer was skipped. Under `cargo test --benches` criterion runs every benchmark once and nothing is written.
 //! With a criterion filter the report is partial and goes to `target/performance-partial.md` instead.
 //!
-//! Single thread, default engine settings. Times are criterion's medians (see `perf_report::Recorder`); the
-//! ratios that should come out at 1 (C ABI, features a chain does not use) are measured interleaved, so a
-//! change of load on the shared machine cannot fake or hide a difference.
+//! Single thread, default engine settings (so the lane solver, but in the scalar-solver variants). Times are
+//! criterion's medians (see `perf_report::Recorder`); the ratios that should come out at 1 (C ABI, features a
+//! chain does not use) and the lane solver's speed-up are measured interleaved, so a change of load on the
+//! shared machine cannot fake or hide a difference.
 
 #[path = "support/peer_pendulum.rs"]
 mod peer_pendulum;
@@ -25,6 +27,7 @@ mod scene_ffi;
 #[path = "support/scenes.rs"]
 mod scenes;
 
+use std::fmt::Write as _;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
@@ -36,16 +39,27 @@ use perf_report::{
 };
 use scene_ffi::{FfiFrame, FfiSceneRun};
 use scenes::{
-    ASLEEP, AWAKE_AT_REST, COLLIDERS, CameraMotion, DISABLED, LIMP, LOD1, LOD2, MASKED_COLLIDERS, PLAIN, PLAIN_STILL,
-    ReadBack, Scene, SceneRun, VIEWS, VIEWS_COLLIDERS, VIEWS_STILL, Variant,
+    ASLEEP, AWAKE_AT_REST, COLLIDERS, CameraMotion, DISABLED, LIMP, LOD1, LOD2, MASKED_COLLIDERS, PLAIN, PLAIN_SCALAR,
+    PLAIN_STILL, ReadBack, Scene, SceneRun, VIEWS, VIEWS_COLLIDERS, VIEWS_STILL, Variant,
 };
 
 #[global_allocator]
 static ALLOCATOR: CountingAllocator = CountingAllocator;
 
-/// The solver path that ran. The engine has only its scalar path so far; once it dispatches on CPU features
-/// at run time, report the path it chose here.
-const SOLVER_PATH: &str = "scalar (no SIMD path in the engine yet)";
+/// The solver path that ran: the lane solver (the default) with the kernel `kodawari::simd_path` reports for
+/// this CPU, and the scalar solver for chains near colliders.
+fn solver_path() -> String {
+    const NEAR_COLLIDERS: &str = "chains near colliders: scalar solver";
+    let lanes = "lane solver (chains of equal length 8 per SIMD group)";
+    match kodawari::simd_path() {
+        "avx2" => format!("{lanes}, avx2 kernel chosen at run time; {NEAR_COLLIDERS}"),
+        "sse2" => format!("{lanes}, sse2 kernel (the portable x86-64 copy: no AVX2 on this CPU); {NEAR_COLLIDERS}"),
+        "scalar" => {
+            format!("{lanes}, no SIMD instructions on this architecture (lanes in scalar code); {NEAR_COLLIDERS}")
+        }
+        path => format!("{lanes}, {path} kernel; {NEAR_COLLIDERS}"),
+    }
+}
 
 const SCENES: [Scene; 7] = [
     Scene::uniform("1x8", 1, 8),
@@ -60,13 +74,15 @@ const SCENES: [Scene; 7] = [
 
 /// Every scene runs these variants (one line per variant).
 const VARIANTS: [Variant; 5] = [PLAIN, VIEWS, VIEWS_STILL, COLLIDERS, VIEWS_COLLIDERS];
+/// Scenes that also run the plain variant on the scalar solver, next to the (default) lane solver.
+const SCALAR_SCENES: [&str; 4] = ["100x16", "1000x16", "1x256", "ragged"];
 /// Controls ("a chain pays nothing for features it does not use") and the per-chain skips, on the 100 x 16
 /// scene only.
 const CONTROLS_SCENE: &str = "100x16";
 const CONTROLS: [Variant; 7] = [PLAIN_STILL, MASKED_COLLIDERS, AWAKE_AT_REST, ASLEEP, DISABLED, LOD1, LOD2];
 
 /// The skips of SPEC 3.8 as (variant against baseline) pairs.
-const SKIPS: [Skip; 9] = [
+const SKIPS: [Skip; 10] = [
     Skip { what: "no view shapes", baseline: "views", with: "plain" },
     Skip { what: "camera direction unchanged", baseline: "views", with: "views_still" },
     Skip { what: "no colliders", baseline: "colliders", with: "plain" },
@@ -76,6 +92,8 @@ const SKIPS: [Skip; 9] = [
     Skip { what: "chain disabled", baseline: "plain", with: "disabled" },
     Skip { what: "level of detail 1", baseline: "plain", with: "lod1" },
     Skip { what: "level of detail 2", baseline: "plain", with: "lod2" },
+    // Not a skip of SPEC 3.8, but read the same way: the lane solver's frame against the scalar solver's.
+    Skip { what: "lane solver instead of the scalar solver", baseline: "plain_scalar", with: "plain" },
 ];
 
 /// Interleaved rounds for the ratios that should be 1, and the length of each block of frames.
@@ -219,6 +237,9 @@ fn bench_scenes(criterion: &mut Criterion, recorder: &Recorder, report: &mut Rep
         for variant in VARIANTS {
             bench_scene(criterion, recorder, report, scene, variant);
         }
+        if SCALAR_SCENES.contains(&scene.name) {
+            bench_scene(criterion, recorder, report, scene, PLAIN_SCALAR);
+        }
         if scene.name == CONTROLS_SCENE {
             for variant in CONTROLS {
                 bench_scene(criterion, recorder, report, scene, variant);
@@ -246,22 +267,41 @@ const NOISE_FLOOR: &str = "100 x 16 A/A control: two identical plain engines";
 const CAMERA_IGNORED: &str = "100 x 16 without view shapes: orbiting camera vs camera still";
 const MASK_IGNORED: &str = "100 x 16: colliders in the engine but in no chain's mask vs no colliders";
 
+/// The lane solver (B, the default) against the scalar solver (A), interleaved: (what, scene, rounds, block).
+/// A 1000 x 16 frame takes tens of milliseconds, so there fewer, longer blocks.
+const SOLVER_PAIRS: [(&str, &str, usize, Duration); 2] =
+    [(LANES_100, "100x16", PAIRED_ROUNDS, PAIRED_BLOCK), (LANES_1000, "1000x16", 20, Duration::from_millis(100))];
+const LANES_100: &str = "100 x 16: lane solver vs scalar solver";
+const LANES_1000: &str = "1000 x 16: lane solver vs scalar solver";
+
+fn build_settled(scene_name: &str, variant: Variant) -> SceneRun {
+    let scene = SCENES.iter().find(|s| s.name == scene_name).expect("the scene is listed");
+    let mut run = SceneRun::new(scene, variant, ReadBack::World).expect("the scene builds");
+    let _ = preroll(|| run.frame());
+    let _ = run.settle();
+    run
+}
+
 fn interleaved_skips(report: &mut Report) {
-    let scene = SCENES.iter().find(|s| s.name == CONTROLS_SCENE).expect("the controls scene is listed");
-    let build = |variant| {
-        let mut run = SceneRun::new(scene, variant, ReadBack::World).expect("the controls scene builds");
-        let _ = preroll(|| run.frame());
-        let _ = run.settle();
-        run
-    };
     for (what, a, b) in INTERLEAVED {
-        let (mut run_a, mut run_b) = (build(a), build(b));
+        let (mut run_a, mut run_b) = (build_settled(CONTROLS_SCENE, a), build_settled(CONTROLS_SCENE, b));
         report.paired.push(paired_ratio(
             what,
             (a.label, &mut || run_a.frame()),
             (b.label, &mut || run_b.frame()),
             PAIRED_ROUNDS,
             PAIRED_BLOCK,
+        ));
+    }
+    for (what, scene, rounds, block) in SOLVER_PAIRS {
+        let (a, b) = (PLAIN_SCALAR, PLAIN);
+        let (mut run_a, mut run_b) = (build_settled(scene, a), build_settled(scene, b));
+        report.paired.push(paired_ratio(
+            what,
+            (a.label, &mut || run_a.frame()),
+            (b.label, &mut || run_b.frame()),
+            rounds,
+            block,
         ));
     }
 }
@@ -524,8 +564,32 @@ fn targets(report: &Report) -> Vec<Target> {
         linearity.map(|r| (1.0 / 1.5..=1.5).contains(&r)),
     ));
 
+    out.push(solver_target(report));
     out.push(peer_target(report));
     out
+}
+
+/// The lane solver's speed-up over the scalar solver on 1000 x 16 (interleaved): for information, met when
+/// the lane solver is faster at all.
+fn solver_target(report: &Report) -> Target {
+    let target = "lane solver speed-up over the scalar solver (interleaved, 1000 x 16)";
+    let Some(big) = report.paired(LANES_1000) else {
+        return Target::check(target, "not run".into(), None);
+    };
+    let speed_up = 1.0 / big.ratio;
+    let mut measured = format!(
+        "{speed_up:.2}x (scalar {} us, lanes {} us per frame, median over {} rounds)",
+        micros(Some(big.a_seconds)),
+        micros(Some(big.b_seconds)),
+        big.rounds
+    );
+    if let Some(small) = report.paired(LANES_100) {
+        let _ = write!(measured, "; 100 x 16: {:.2}x", 1.0 / small.ratio);
+    }
+    if let Some(floor) = report.paired(NOISE_FLOOR) {
+        let _ = write!(measured, " (A/A control of the method: {:.3})", floor.ratio);
+    }
+    Target::check(target, measured, Some(speed_up > 1.0))
 }
 
 /// Faster than rapier3d at equal or lower pendulum error: every rapier pendulum row against kodawari's
@@ -595,7 +659,7 @@ fn main() {
     ));
     let substeps = report.scene("1000x16", PLAIN.id).map_or(4.0, |r| r.substeps.max(1) as f64);
     let bound = Bound::new(&machine, substeps);
-    let markdown = report.markdown(&machine, SOLVER_PATH, &bound, started.elapsed());
+    let markdown = report.markdown(&machine, &solver_path(), &bound, started.elapsed());
     let complete = !report.scenes.iter().any(|r| r.missing.as_deref() == Some(FILTERED_OUT));
     let path = if complete { Path::new("docs/performance.md") } else { Path::new("target/performance-partial.md") };
     std::fs::write(path, &markdown).expect("write the performance report");

@@ -54,6 +54,16 @@ fn scene() -> (Engine, usize, usize) {
             engine.add_view_shape(id, -Vec3::X, &side, 2.0).unwrap();
         }
     }
+    // Eight chains of one length that touch no collider: a group of the lane solver.
+    for c in 0..8 {
+        let params = ChainParams { collision_mask: 0, stiffness: 0.3 + 0.05 * c as f32, ..Default::default() };
+        let direction = Vec3::new(0.5, 1.0, 0.1 * c as f32);
+        let id = engine.create_chain(params, &straight_chain(9, Vec3::ZERO, direction, 0.03)).unwrap();
+        if c % 2 == 0 {
+            let side = curled_chain(9, Vec3::ZERO, direction, Vec3::X, 0.3, 0.03);
+            engine.add_view_shape(id, Vec3::Z, &side, 1.0).unwrap();
+        }
+    }
     let head = ColliderDef { shape: ColliderShape::Sphere { radius: 0.1 }, transform: at(HEAD), layers: 1 };
     let arm = ColliderDef {
         shape: ColliderShape::Capsule { radius: 0.04, half_height: 0.2 },
@@ -63,7 +73,7 @@ fn scene() -> (Engine, usize, usize) {
     engine.create_collider(&head).unwrap();
     engine.create_collider(&arm).unwrap();
     let joints = engine.joint_count();
-    (engine, 6, joints)
+    (engine, 14, joints)
 }
 
 fn frame(engine: &mut Engine, n: usize, anchors: &mut [Transform], out: &mut [Transform], rotations: &mut [Quat]) {

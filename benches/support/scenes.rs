@@ -10,7 +10,7 @@
 use std::f32::consts::{PI, TAU};
 
 use glam::{Quat, Vec3};
-use kodawari::{AnchorSource, ChainParams, ColliderDef, ColliderShape, Engine, EngineSettings, Transform};
+use kodawari::{AnchorSource, ChainParams, ColliderDef, ColliderShape, Engine, EngineSettings, Solver, Transform};
 
 /// The host's frame time: a 60 Hz game.
 pub const FRAME_DT: f32 = 1.0 / 60.0;
@@ -146,6 +146,8 @@ pub struct Variant {
     pub lod: u32,
     /// `ChainParams::stiffness`; `None`: the default.
     pub stiffness: Option<f32>,
+    /// `Engine::set_solver`; `None`: the engine's default (the lane solver).
+    pub solver: Option<Solver>,
 }
 
 /// No view shapes, no colliders, swaying heads: the bare rod. The camera orbits (it must not matter).
@@ -159,7 +161,11 @@ pub const PLAIN: Variant = Variant {
     activity: Activity::Active,
     lod: 0,
     stiffness: None,
+    solver: None,
 };
+/// As `PLAIN` on the scalar (one chain at a time) solver instead of the default lane solver.
+pub const PLAIN_SCALAR: Variant =
+    Variant { id: "plain_scalar", label: "plain, scalar solver", solver: Some(Solver::Scalar), ..PLAIN };
 /// As `PLAIN` with a camera that never turns: shows that a chain without view shapes ignores the camera.
 pub const PLAIN_STILL: Variant =
     Variant { id: "plain_still", label: "plain, camera still", camera: CameraMotion::Still, ..PLAIN };
@@ -341,12 +347,15 @@ pub struct SceneRun {
 }
 
 impl SceneRun {
-    /// Builds the scene at default engine settings (but for the variant's LOD and sleeping). Fails only if
-    /// the engine rejects part of the rig.
+    /// Builds the scene at default engine settings (but for the variant's LOD, sleeping and solver). Fails only
+    /// if the engine rejects part of the rig.
     pub fn new(scene: &Scene, variant: Variant, read_back: ReadBack) -> kodawari::Result<Self> {
         let defaults = EngineSettings::default();
         let sleep_speed = if variant.activity == Activity::NeverSleep { 0.0 } else { defaults.sleep_speed };
         let mut engine = Engine::new(EngineSettings { lod: variant.lod, sleep_speed, ..defaults })?;
+        if let Some(solver) = variant.solver {
+            engine.set_solver(solver);
+        }
         let layout = Layout::new(scene);
         for i in 0..scene.chains {
             let character = layout.character_of[i];

@@ -60,6 +60,66 @@ impl ChainConstants {
     }
 }
 
+/// One chain's substeps of a step on the scalar solver.
+struct ScalarRun<'a> {
+    /// The anchor at the start and end of the step, relative to the engine origin.
+    start: Transform,
+    target: Transform,
+    constants: &'a ChainConstants,
+    iterations: u32,
+    h: f64,
+    /// Fraction of the anchor motion reached at the end of each substep.
+    progress: &'a [f32],
+    collider_count: usize,
+}
+
+impl ScalarRun<'_> {
+    /// Runs the substeps, with contacts against `contacts.candidates` (none when empty). Returns the substeps
+    /// whose direct inextensibility solve fell back and the contact pairs tested.
+    fn step(&self, chain: &mut Chain, contacts: &mut ContactScratch, scratch: &mut RodScratch) -> (u64, u64) {
+        let (h, collider_count) = (self.h, self.collider_count);
+        let slop = CONTACT_SLOP * chain.frame.lengths.iter().copied().fold(f32::INFINITY, f32::min);
+        let substeps = self.progress.len();
+        let (mut fallbacks, mut contact_pairs) = (0, 0);
+        for (s, &progress) in self.progress.iter().enumerate() {
+            let anchor = self.start.interpolate(&self.target, progress);
+            let touching = !contacts.candidates.is_empty();
+            if touching {
+                let row = &contacts.sweeps[s * collider_count..][..collider_count];
+                contacts.chain_sweeps.clear();
+                contacts.chain_sweeps.extend(contacts.candidates.iter().map(|&c| row[c]));
+            }
+            let input = SubstepInput {
+                h: h as f32,
+                anchor,
+                gravity: self.constants.gravity,
+                velocity_decay: self.constants.velocity_decay,
+                alpha_per_iteration: self.constants.alpha_per_iteration,
+                iterations: self.iterations,
+                orientation_weight: self.constants.orientation_weight,
+                rest: &chain.rest,
+                rest_groups: &chain.rest_groups,
+                shortest_segment: chain.shortest_segment,
+                half_kick: chain.half_kick,
+                contacts: touching.then(|| ContactInput {
+                    colliders: &contacts.chain_sweeps,
+                    radii: &contacts.radii,
+                    friction: chain.params.friction,
+                    slop,
+                }),
+            };
+            let report = substep(&mut chain.state, &chain.frame.lengths, &input, scratch);
+            fallbacks += report.fallback as u64;
+            contact_pairs += report.contact_pairs;
+            chain.half_kick = false;
+            if s + 2 >= substeps {
+                chain.capture_local(&anchor);
+            }
+        }
+        (fallbacks, contact_pairs)
+    }
+}
+
 /// Share of a chain's shortest segment a joint must have been inside a collider at the start of a substep to
 /// count as overlapping since then (see [`ContactInput::slop`]).
 const CONTACT_SLOP: f32 = 1e-3;
@@ -90,6 +150,7 @@ pub struct Engine {
     lanes: LaneSolver,
     /// The chains the lane solver steps in the current step, and the anchor progress of each substep.
     lane_jobs: Vec<LaneJob>,
+    lane_leftovers: Vec<LaneJob>,
     progress: Vec<f32>,
     stats: Stats,
 }
@@ -127,6 +188,7 @@ impl Engine {
             solver: Solver::default(),
             lanes: LaneSolver::default(),
             lane_jobs: Vec::new(),
+            lane_leftovers: Vec::new(),
             progress: Vec::new(),
             stats: Stats::default(),
         })
@@ -567,6 +629,8 @@ impl Engine {
             if span > 0.0 { (((s + 1) as f64 * h - before) / span).clamp(0.0, 1.0) as f32 } else { 1.0 }
         };
 
+        self.progress.clear();
+        self.progress.extend((0..substeps).map(progress));
         let progress_at_start = |s: u64| if s == 0 { 0.0 } else { progress(s - 1) };
         self.sweep_colliders(substeps, origin, progress_at_start, progress);
         let collider_count = self.collider_order.len();
@@ -666,7 +730,7 @@ impl Engine {
                 }
                 chain.refresh_rest_groups();
             }
-            if self.solver == Solver::Lanes && self.contact_scratch.candidates.is_empty() && substeps > 0 {
+            if self.solver != Solver::Scalar && self.contact_scratch.candidates.is_empty() && substeps > 0 {
                 self.lane_jobs.push(LaneJob {
                     slot,
                     joints: chain.joint_count(),
@@ -680,51 +744,47 @@ impl Engine {
                 });
                 continue;
             }
-            let slop = CONTACT_SLOP * chain.frame.lengths.iter().copied().fold(f32::INFINITY, f32::min);
-            for s in 0..substeps {
-                let anchor = start.interpolate(&target, progress(s));
-                let contacts = &mut self.contact_scratch;
-                let touching = !contacts.candidates.is_empty();
-                if touching {
-                    let row = &contacts.sweeps[s as usize * collider_count..][..collider_count];
-                    contacts.chain_sweeps.clear();
-                    contacts.chain_sweeps.extend(contacts.candidates.iter().map(|&c| row[c]));
-                }
-                let input = SubstepInput {
-                    h: h as f32,
-                    anchor,
-                    gravity: constants.gravity,
-                    velocity_decay: constants.velocity_decay,
-                    alpha_per_iteration: constants.alpha_per_iteration,
-                    iterations,
-                    orientation_weight: constants.orientation_weight,
-                    rest: &chain.rest,
-                    rest_groups: &chain.rest_groups,
-                    shortest_segment: chain.shortest_segment,
-                    half_kick: chain.half_kick,
-                    contacts: touching.then(|| ContactInput {
-                        colliders: &contacts.chain_sweeps,
-                        radii: &contacts.radii,
-                        friction: params.friction,
-                        slop,
-                    }),
-                };
-                let report = substep(&mut chain.state, &chain.frame.lengths, &input, &mut self.scratch);
-                fallbacks += report.fallback as u64;
-                contact_pairs += report.contact_pairs;
-                chain.half_kick = false;
-                if s + 2 >= substeps {
-                    chain.capture_local(&anchor);
-                }
-            }
+            let run = ScalarRun {
+                start,
+                target,
+                constants: &constants,
+                iterations,
+                h,
+                progress: &self.progress,
+                collider_count,
+            };
+            let (chain_fallbacks, pairs) = run.step(chain, &mut self.contact_scratch, &mut self.scratch);
+            fallbacks += chain_fallbacks;
+            contact_pairs += pairs;
             chain.finish_step(still, substeps, h, after, &settings);
         }
         if !self.lane_jobs.is_empty() {
-            self.progress.clear();
-            self.progress.extend((0..substeps).map(progress));
             let clock = Clock { h: h as f32, iterations, progress: &self.progress };
-            fallbacks += self.lanes.step(&mut self.chains, &mut self.lane_jobs, &clock);
-            for job in self.lane_jobs.drain(..) {
+            let portable = self.solver == Solver::LanesPortable;
+            fallbacks +=
+                self.lanes.step(&mut self.chains, &mut self.lane_jobs, &mut self.lane_leftovers, &clock, portable);
+            // Lengths shared by fewer chains than the narrowest lane group are faster on the scalar solver.
+            self.contact_scratch.candidates.clear();
+            for job in &self.lane_leftovers {
+                let chain = self.chains.at_mut(job.slot as usize).expect("live");
+                let constants = ChainConstants {
+                    alpha_per_iteration: job.alpha_per_iteration,
+                    velocity_decay: job.velocity_decay,
+                    gravity: job.gravity,
+                    orientation_weight: job.orientation_weight,
+                };
+                let run = ScalarRun {
+                    start: job.start,
+                    target: job.target,
+                    constants: &constants,
+                    iterations,
+                    h,
+                    progress: &self.progress,
+                    collider_count,
+                };
+                fallbacks += run.step(chain, &mut self.contact_scratch, &mut self.scratch).0;
+            }
+            for job in self.lane_jobs.drain(..).chain(self.lane_leftovers.drain(..)) {
                 let chain = self.chains.at_mut(job.slot as usize).expect("live");
                 chain.finish_step(job.still, substeps, h, after, &settings);
             }

@@ -83,17 +83,16 @@ fn match_shape<const L: usize>(g: &mut LaneGroup<L>) {
     }
     g.qp[1] = g.qp[1].nlerp_shorter(rotation.mul(g.qbar[1]), alpha);
 
-    let orientation_term = |g: &LaneGroup<L>, j: usize| M3::from_quat(g.qp[j].mul(g.qbar_inv[j])).scale(ow);
     let mut carried: Option<M3<L>> = None;
     for i in 2..n {
         let lo = i - 1;
         let full = i + 1 < n;
         let [r_lo, r_mid, r_hi] = g.offsets[i];
-        let m_lo = orientation_term(g, lo);
-        let m_mid = carried.take().unwrap_or_else(|| orientation_term(g, i));
+        let m_lo = orientation_term(g, lo, ow);
+        let m_mid = carried.take().unwrap_or_else(|| orientation_term(g, i, ow));
         let (c, a) = if full {
             let hi = i + 1;
-            let m_hi = orientation_term(g, hi);
+            let m_hi = orientation_term(g, hi, ow);
             carried = Some(m_hi);
             let c = (DV3::ZERO + g.p[lo] + g.p[i] + g.p[hi]) / 3.0;
             let a = m_lo
@@ -123,6 +122,12 @@ fn match_shape<const L: usize>(g: &mut LaneGroup<L>) {
     }
 }
 
+/// A member's orientation term of the group matrix.
+#[inline(always)]
+fn orientation_term<const L: usize>(g: &LaneGroup<L>, j: usize, weight: F<L>) -> M3<L> {
+    M3::from_quat(g.qp[j].mul(g.qbar_inv[j])).scale(weight)
+}
+
 #[inline(always)]
 fn pull_to_goal<const L: usize>(p: DV3<L>, centre: DV3<L>, offset: V3<L>, alpha: D<L>) -> DV3<L> {
     let goal = centre + offset.to_f64();
@@ -138,8 +143,11 @@ fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>) -> M3<L> {
     for _ in 0..POLAR_ITERATIONS {
         let r = M3::from_quat(*q);
         // Columns of `S = R^T A`.
-        let col = |c: V3<L>| V3 { x: r.x_axis.dot(c), y: r.y_axis.dot(c), z: r.z_axis.dot(c) };
-        let s = M3 { x_axis: col(a.x_axis), y_axis: col(a.y_axis), z_axis: col(a.z_axis) };
+        let s = M3 {
+            x_axis: r.transpose_mul(a.x_axis),
+            y_axis: r.transpose_mul(a.y_axis),
+            z_axis: r.transpose_mul(a.z_axis),
+        };
         let g = V3 { x: s.y_axis.z - s.z_axis.y, y: s.z_axis.x - s.x_axis.z, z: s.x_axis.y - s.y_axis.x };
         let trace = s.x_axis.x + s.y_axis.y + s.z_axis.z;
         let muller = g.scale(F::splat(1.0) / (trace.abs() + guard));

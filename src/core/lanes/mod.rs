@@ -2,17 +2,19 @@
 //!
 //! Most chains of a character are alike (a head of hair: dozens of strands of one length), and the scalar
 //! solver leaves most of a modern CPU's vector width unused. Here a step sorts the chains it simulates by
-//! joint count, cuts each run of equal length into groups of 8, 4, 2 and 1 chains (so no lane is ever
-//! padding), and advances each group through all of the step's substeps in structure-of-arrays buffers.
+//! joint count (and limp or not), cuts each run of equal length into groups of 8 and 4 chains (so no lane is
+//! ever padding), and advances each group through all of the step's substeps in structure-of-arrays
+//! buffers. The last 1 to 3 chains of a run, too few for a group, take the scalar solver.
 //!
 //! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group; [`group`]: the buffers.
 //! - The wide copies of the kernel are compiled for AVX2 next to the portable (SSE2) one and chosen at run
 //!   time by CPU-feature detection ([`multiversion`]); no build needs `target-cpu=native`.
-//! - Determinism: a chain's result does not depend on its lane, on the group it shares, or on which copy of
-//!   the kernel ran (no fused or reordered floating-point operations): the same bits on every x86-64 and
-//!   aarch64 CPU. It differs from the scalar solver ([`Solver::Scalar`]) by float rounding only (the two
-//!   implement the same operations, grouped differently); `tests/lanes.rs` and the accuracy report measure
-//!   by how much.
+//! - Determinism: a chain's result does not depend on its lane, on the group it shares (8 or 4 wide), or on
+//!   which copy of the kernel ran (no fused or reordered floating-point operations): the same bits on every
+//!   x86-64 and aarch64 CPU. It differs from the scalar solver ([`Solver::Scalar`]) by float rounding only
+//!   (the two implement the same operations, grouped differently); `tests/lanes.rs` and the accuracy report
+//!   measure by how much. So whether a chain runs in lanes (it has at least 3 siblings of its joint count in
+//!   the step) changes its motion by rounding, never more; the same inputs always give the same bits.
 //! - Chains that may touch a collider in a step take the scalar solver for that step (the contact pass is
 //!   scalar); everything else a chain does (sleeping, teleports, momentum suppression, output) is shared.
 
@@ -34,6 +36,9 @@ pub enum Solver {
     /// Chains of equal joint count side by side in SIMD lanes (the default).
     #[default]
     Lanes,
+    /// [`Lanes`](Self::Lanes) with the portable copy of its kernel (SSE2 on x86-64) whatever the CPU has: the
+    /// same bits, slower. For checking the determinism policy on one machine.
+    LanesPortable,
     /// One chain at a time: the reference implementation (and what chains near colliders always use).
     Scalar,
 }
@@ -91,15 +96,44 @@ pub(crate) struct Clock<'a> {
 pub struct LaneSolver {
     g8: LaneGroup<8>,
     g4: LaneGroup<4>,
-    g2: LaneGroup<2>,
-    g1: LaneGroup<1>,
 }
 
+/// The narrowest lane group. Fewer chains of a kind than this run faster on the scalar solver, whose glam
+/// types use SIMD within a vector: a lane kernel one or two chains wide measured 1.5x slower than it.
+const NARROWEST: usize = 4;
+
 impl LaneSolver {
-    /// Runs every substep of the step for the chains of `jobs` (reordered by joint count). Returns the
-    /// substeps, summed over the chains, in which the direct inextensibility solve fell back.
-    pub(crate) fn step(&mut self, chains: &mut Arena<Chain>, jobs: &mut [LaneJob], clock: &Clock<'_>) -> u64 {
+    /// Runs every substep of the step for the chains of `jobs` (reordered by joint count) that fill lane
+    /// groups, and moves the others (fewer than [`NARROWEST`] of a kind) to `leftovers` for the scalar solver.
+    /// Returns the substeps, summed over the chains, in which the direct inextensibility solve fell back.
+    pub(crate) fn step(
+        &mut self,
+        chains: &mut Arena<Chain>,
+        jobs: &mut Vec<LaneJob>,
+        leftovers: &mut Vec<LaneJob>,
+        clock: &Clock<'_>,
+        portable: bool,
+    ) -> u64 {
         jobs.sort_unstable_by_key(|j| (j.key(), j.slot));
+        leftovers.clear();
+        let mut kept = 0;
+        let mut first = 0;
+        while first < jobs.len() {
+            let key = jobs[first].key();
+            let len = jobs[first..].iter().take_while(|j| j.key() == key).count();
+            // Full groups of the narrowest width stay; the run's tail goes to the scalar solver.
+            let full = len / NARROWEST * NARROWEST;
+            for i in first..first + len {
+                if i - first < full {
+                    jobs[kept] = jobs[i];
+                    kept += 1;
+                } else {
+                    leftovers.push(jobs[i]);
+                }
+            }
+            first += len;
+        }
+        jobs.truncate(kept);
         let mut fallbacks = 0;
         let mut rest = &jobs[..];
         while let Some(first) = rest.first() {
@@ -107,18 +141,13 @@ impl LaneSolver {
             let (mut run, tail) = rest.split_at(same);
             rest = tail;
             while !run.is_empty() {
-                let (group, remaining) = run.split_at(match run.len() {
-                    8.. => 8,
-                    4.. => 4,
-                    2.. => 2,
-                    _ => 1,
-                });
+                let (group, remaining) = run.split_at(if run.len() >= 8 { 8 } else { 4 });
                 run = remaining;
-                fallbacks += match group.len() {
-                    8 => run_group(&mut self.g8, chains, group, clock, substep8),
-                    4 => run_group(&mut self.g4, chains, group, clock, substep4),
-                    2 => run_group(&mut self.g2, chains, group, clock, substep2),
-                    _ => run_group(&mut self.g1, chains, group, clock, kernel::substep::<1>),
+                fallbacks += match (group.len(), portable) {
+                    (8, false) => run_group(&mut self.g8, chains, group, clock, substep8),
+                    (8, true) => run_group(&mut self.g8, chains, group, clock, kernel::substep::<8>),
+                    (_, false) => run_group(&mut self.g4, chains, group, clock, substep4),
+                    (_, true) => run_group(&mut self.g4, chains, group, clock, kernel::substep::<4>),
                 };
             }
         }
@@ -133,11 +162,6 @@ fn substep8(g: &mut LaneGroup<8>, s: usize) -> Mask<8> {
 
 #[multiversion(targets("x86_64+avx2"))]
 fn substep4(g: &mut LaneGroup<4>, s: usize) -> Mask<4> {
-    kernel::substep(g, s)
-}
-
-#[multiversion(targets("x86_64+avx2"))]
-fn substep2(g: &mut LaneGroup<2>, s: usize) -> Mask<2> {
     kernel::substep(g, s)
 }
 

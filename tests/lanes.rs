@@ -51,21 +51,7 @@ fn strands() -> Vec<Strand> {
 }
 
 fn build(solver: Solver, strands: &[Strand]) -> (Engine, Vec<(ChainId, f32)>) {
-    let mut engine = Engine::new(EngineSettings::default()).unwrap();
-    engine.set_solver(solver);
-    let mut ids = Vec::new();
-    for (i, s) in strands.iter().enumerate() {
-        let angle = i as f32 * 0.7;
-        let direction = Vec3::new(angle.cos(), 0.4, angle.sin());
-        let base = curled_chain(s.joints, Vec3::new(0.0, 0.1, 0.0), direction, Vec3::Y, 0.2, 0.03);
-        let id = engine.create_chain(s.params, &base).unwrap();
-        if s.views {
-            let view = curled_chain(s.joints, Vec3::new(0.0, 0.1, 0.0), direction, Vec3::X, -0.4, 0.03);
-            engine.add_view_shape(id, Vec3::X, &view, 2.0).unwrap();
-        }
-        ids.push((id, chain_length(&base)));
-    }
-    (engine, ids)
+    build_with_subject_at(strands, usize::MAX, solver)
 }
 
 /// Largest distance between the two engines' joints, per chain length, over `frames`, checked every frame.
@@ -140,7 +126,8 @@ fn a_chains_motion_does_not_depend_on_its_lane_or_group() {
     println!("lane solver kernel: {}", kodawari::simd_path());
 }
 
-/// [`build`], except that the chain at `subject` always gets the same rest shape (that of angle 0).
+/// Chain `i` grows in a direction of its own (angle `0.7 i` around the head), but the one at `subject`, which
+/// always gets angle 0.
 fn build_with_subject_at(strands: &[Strand], subject: usize, solver: Solver) -> (Engine, Vec<(ChainId, f32)>) {
     let mut engine = Engine::new(EngineSettings::default()).unwrap();
     engine.set_solver(solver);

@@ -113,8 +113,9 @@ fn new_engine(settings: EngineSettings) -> Engine {
 
 /// Creates a scenario's chain. In the solver comparison (`SOLVER` set) three identical siblings come with it,
 /// so that with `Solver::Lanes` the chain runs in a lane group of 4 (a lone chain takes the scalar solver: too
-/// few of its kind for a lane group). The siblings' motion is the chain's own; read-backs and fallback counts
-/// include them on both solvers alike.
+/// few of its kind for a lane group). The siblings get the chain's parameters and base shape (not view shapes
+/// added to it afterwards); read-backs are the chain's alone, fallback counts include the siblings on both
+/// solvers alike.
 fn new_chain(engine: &mut Engine, params: ChainParams, base: &[Transform]) -> ChainId {
     let id = engine.create_chain(params, base).unwrap();
     if SOLVER.with(Cell::get).is_some() {

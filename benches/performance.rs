@@ -47,10 +47,11 @@ use scenes::{
 static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 /// The solver path that ran: the lane solver (the default) with the kernel `kodawari::simd_path` reports for
-/// this CPU, and the scalar solver for chains near colliders.
+/// this CPU, and the scalar solver for chains near colliders and the few left over from the lane groups.
 fn solver_path() -> String {
-    const NEAR_COLLIDERS: &str = "chains near colliders: scalar solver";
-    let lanes = "lane solver (chains of equal length 8 per SIMD group)";
+    const NEAR_COLLIDERS: &str =
+        "chains near colliders and the last 1-3 of a joint count (too few for a group): scalar solver";
+    let lanes = "lane solver (chains of equal joint count in SIMD groups of 8 or 4)";
     match kodawari::simd_path() {
         "avx2" => format!("{lanes}, avx2 kernel chosen at run time; {NEAR_COLLIDERS}"),
         "sse2" => format!("{lanes}, sse2 kernel (the portable x86-64 copy: no AVX2 on this CPU); {NEAR_COLLIDERS}"),
@@ -202,6 +203,7 @@ fn bench_scene(criterion: &mut Criterion, recorder: &Recorder, report: &mut Repo
                 allocations,
                 solver_fallbacks: (after.solver_fallbacks - before.solver_fallbacks) as f64 / CHECK_FRAMES as f64,
                 contact_pairs: (after.contact_pairs_tested - before.contact_pairs_tested) as f64 / CHECK_FRAMES as f64,
+                lane_chains: after.lane_chains,
             });
             (recorder.median_frame(&id, budget.sample_size), r.substeps_last_frame(), Some(allocations), None)
         }

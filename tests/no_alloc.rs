@@ -105,6 +105,7 @@ fn a_frame_allocates_nothing() {
         frame(&mut engine, n, &mut anchors, &mut out, &mut rotations);
     }
     let rust_allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+    assert_eq!(engine.stats().lane_chains, 8, "the eight equal chains form a lane group");
 
     // The same frame through the C ABI's one-call path.
     use kodawari::ffi::engine::*;

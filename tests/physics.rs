@@ -61,6 +61,8 @@ fn fine_rope_stays_inextensible_when_the_direct_solve_fails() {
                 substeps * copies
             );
             assert!(fallbacks > 0, "the scene no longer exercises the fallback");
+            let in_lanes = if solver == Solver::Lanes { copies as u32 } else { 0 };
+            assert_eq!(engine.stats().lane_chains, in_lanes);
             assert!(worst <= 1e-4, "stretch {worst} with {joints} joints ({solver:?})");
         }
     }

@@ -312,6 +312,8 @@ pub struct Counters {
     pub solver_fallbacks: f64,
     /// (segment or particle, collider) pairs tested (`Stats::contact_pairs_tested`).
     pub contact_pairs: f64,
+    /// Chains the lane solver stepped in the last of those frames (`Stats::lane_chains`).
+    pub lane_chains: u32,
 }
 
 /// One (scene, variant) benchmark.
@@ -501,18 +503,20 @@ impl Report {
              solver (equal-length chains side by side in SIMD lanes; in every variant, chains that may touch a \
              collider in a step take the scalar solver for that step). \
              Read over 3 frames after each benchmark: heap allocations (a counting allocator), inextensibility \
-             solver fallbacks and contact pairs tested (`Stats`), per frame.\n\n\
+             solver fallbacks and contact pairs tested (`Stats`), per frame, and the chains the lane solver stepped \
+             in the last of them (`Stats::lane_chains`).\n\n\
              | scene | chains x joints | dynamic joints | variant | ns/joint/substep | us/frame | allocs | fallbacks \
-             | contact pairs |\n\
-             |---|---|---|---|---|---|---|---|---|\n",
+             | contact pairs | in lanes |\n\
+             |---|---|---|---|---|---|---|---|---|---|\n",
         );
         for r in &self.scenes {
             let counter = |f: fn(&Counters) -> f64| r.counters.as_ref().map_or("-".into(), |c| format!("{:.1}", f(c)));
             let counters = format!(
-                "{} | {} | {}",
+                "{} | {} | {} | {}",
                 counter(|c| c.allocations),
                 counter(|c| c.solver_fallbacks),
-                counter(|c| c.contact_pairs)
+                counter(|c| c.contact_pairs),
+                r.counters.as_ref().map_or("-".into(), |c| c.lane_chains.to_string())
             );
             let time = match &r.missing {
                 Some(why) => (why.clone(), why.clone()),

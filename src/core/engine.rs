@@ -14,7 +14,7 @@ use super::error::{Error, Result};
 use super::lanes::{Clock, LaneJob, LaneSolver, Solver};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
 use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, TeleportMode};
-use super::rod::{RodScratch, SubstepInput, carry_to_new_rest, substep};
+use super::rod::{ChainConstants, RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
 
 pub type ChainId = Id<Chain>;
@@ -39,25 +39,8 @@ pub struct Stats {
     /// (segment or particle, collider) pairs the contact pass tested, over all steps: 0 while no chain can
     /// touch a collider.
     pub contact_pairs_tested: u64,
-}
-
-/// A chain's solver inputs that stay the same through a step.
-struct ChainConstants {
-    alpha_per_iteration: f32,
-    velocity_decay: f32,
-    gravity: Vec3,
-    orientation_weight: f32,
-}
-
-impl ChainConstants {
-    fn new(params: &ChainParams, settings: &EngineSettings, h: f32, iterations: u32) -> Self {
-        Self {
-            alpha_per_iteration: params.alpha_per_iteration(h, iterations),
-            velocity_decay: (-params.damping * h).exp(),
-            gravity: settings.gravity * (params.gravity_scale * settings.scale),
-            orientation_weight: (params.radius * settings.scale).powi(2) / 5.0,
-        }
-    }
+    /// Chains the lane solver stepped in the last step (the others the scalar solver, or none).
+    pub lane_chains: u32,
 }
 
 /// One chain's substeps of a step on the scalar solver.
@@ -65,7 +48,7 @@ struct ScalarRun<'a> {
     /// The anchor at the start and end of the step, relative to the engine origin.
     start: Transform,
     target: Transform,
-    constants: &'a ChainConstants,
+    constants: ChainConstants,
     iterations: u32,
     h: f64,
     /// Fraction of the anchor motion reached at the end of each substep.
@@ -74,17 +57,22 @@ struct ScalarRun<'a> {
 }
 
 impl ScalarRun<'_> {
-    /// Runs the substeps, with contacts against `contacts.candidates` (none when empty). Returns the substeps
-    /// whose direct inextensibility solve fell back and the contact pairs tested.
-    fn step(&self, chain: &mut Chain, contacts: &mut ContactScratch, scratch: &mut RodScratch) -> (u64, u64) {
+    /// Runs the substeps, with contacts against `contacts.candidates` when given (and not empty). Returns the
+    /// substeps whose direct inextensibility solve fell back and the contact pairs tested.
+    fn step(
+        &self,
+        chain: &mut Chain,
+        mut contacts: Option<&mut ContactScratch>,
+        scratch: &mut RodScratch,
+    ) -> (u64, u64) {
         let (h, collider_count) = (self.h, self.collider_count);
         let slop = CONTACT_SLOP * chain.frame.lengths.iter().copied().fold(f32::INFINITY, f32::min);
         let substeps = self.progress.len();
         let (mut fallbacks, mut contact_pairs) = (0, 0);
         for (s, &progress) in self.progress.iter().enumerate() {
             let anchor = self.start.interpolate(&self.target, progress);
-            let touching = !contacts.candidates.is_empty();
-            if touching {
+            let touching = contacts.as_ref().is_some_and(|c| !c.candidates.is_empty());
+            if let Some(contacts) = contacts.as_deref_mut().filter(|_| touching) {
                 let row = &contacts.sweeps[s * collider_count..][..collider_count];
                 contacts.chain_sweeps.clear();
                 contacts.chain_sweeps.extend(contacts.candidates.iter().map(|&c| row[c]));
@@ -92,16 +80,13 @@ impl ScalarRun<'_> {
             let input = SubstepInput {
                 h: h as f32,
                 anchor,
-                gravity: self.constants.gravity,
-                velocity_decay: self.constants.velocity_decay,
-                alpha_per_iteration: self.constants.alpha_per_iteration,
+                constants: self.constants,
                 iterations: self.iterations,
-                orientation_weight: self.constants.orientation_weight,
                 rest: &chain.rest,
                 rest_groups: &chain.rest_groups,
                 shortest_segment: chain.shortest_segment,
                 half_kick: chain.half_kick,
-                contacts: touching.then(|| ContactInput {
+                contacts: contacts.as_deref().filter(|_| touching).map(|contacts| ContactInput {
                     colliders: &contacts.chain_sweeps,
                     radii: &contacts.radii,
                     friction: chain.params.friction,
@@ -639,6 +624,7 @@ impl Engine {
         let mut fallbacks = 0u64;
         let mut contact_pairs = 0u64;
         let mut idle = 0u32;
+        let mut lane_chains = 0u32;
         for &slot in &self.order {
             let chain = self.chains.at_mut(slot as usize).expect("live");
             let anchor_world = match chain.params.anchor {
@@ -731,29 +717,11 @@ impl Engine {
                 chain.refresh_rest_groups();
             }
             if self.solver != Solver::Scalar && self.contact_scratch.candidates.is_empty() && substeps > 0 {
-                self.lane_jobs.push(LaneJob {
-                    slot,
-                    joints: chain.joint_count(),
-                    start,
-                    target,
-                    alpha_per_iteration: constants.alpha_per_iteration,
-                    velocity_decay: constants.velocity_decay,
-                    gravity: constants.gravity,
-                    orientation_weight: constants.orientation_weight,
-                    still,
-                });
+                self.lane_jobs.push(LaneJob { slot, joints: chain.joint_count(), start, target, constants, still });
                 continue;
             }
-            let run = ScalarRun {
-                start,
-                target,
-                constants: &constants,
-                iterations,
-                h,
-                progress: &self.progress,
-                collider_count,
-            };
-            let (chain_fallbacks, pairs) = run.step(chain, &mut self.contact_scratch, &mut self.scratch);
+            let run = ScalarRun { start, target, constants, iterations, h, progress: &self.progress, collider_count };
+            let (chain_fallbacks, pairs) = run.step(chain, Some(&mut self.contact_scratch), &mut self.scratch);
             fallbacks += chain_fallbacks;
             contact_pairs += pairs;
             chain.finish_step(still, substeps, h, after, &settings);
@@ -763,26 +731,20 @@ impl Engine {
             let portable = self.solver == Solver::LanesPortable;
             fallbacks +=
                 self.lanes.step(&mut self.chains, &mut self.lane_jobs, &mut self.lane_leftovers, &clock, portable);
+            lane_chains = self.lane_jobs.len() as u32;
             // Lengths shared by fewer chains than the narrowest lane group are faster on the scalar solver.
-            self.contact_scratch.candidates.clear();
             for job in &self.lane_leftovers {
                 let chain = self.chains.at_mut(job.slot as usize).expect("live");
-                let constants = ChainConstants {
-                    alpha_per_iteration: job.alpha_per_iteration,
-                    velocity_decay: job.velocity_decay,
-                    gravity: job.gravity,
-                    orientation_weight: job.orientation_weight,
-                };
                 let run = ScalarRun {
                     start: job.start,
                     target: job.target,
-                    constants: &constants,
+                    constants: job.constants,
                     iterations,
                     h,
                     progress: &self.progress,
                     collider_count,
                 };
-                fallbacks += run.step(chain, &mut self.contact_scratch, &mut self.scratch).0;
+                fallbacks += run.step(chain, None, &mut self.scratch).0;
             }
             for job in self.lane_jobs.drain(..).chain(self.lane_leftovers.drain(..)) {
                 let chain = self.chains.at_mut(job.slot as usize).expect("live");
@@ -798,6 +760,7 @@ impl Engine {
         self.accumulator = after;
         self.stats.contact_pairs_tested += contact_pairs;
         self.stats.chains_asleep = idle;
+        self.stats.lane_chains = lane_chains;
         self.stats.substeps_last_step = substeps as u32;
         self.stats.substeps_total += substeps;
         self.stats.solver_fallbacks += fallbacks;

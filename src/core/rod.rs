@@ -7,6 +7,7 @@ use glam::{DVec3, Mat3A, Quat, Vec3, Vec3A};
 use super::collision::{ContactInput, collide, pre_stabilise};
 use super::inextensible::{self, ConstraintScratch};
 use super::math::{Transform, align_hemisphere, exp_small, log_small, nlerp_shorter};
+use super::params::{ChainParams, EngineSettings};
 use super::polar::extract_rotation;
 use super::shape::Shape;
 
@@ -86,19 +87,36 @@ impl RodState {
     }
 }
 
+/// A chain's solver inputs that stay the same through a step (both solvers take them).
+#[derive(Clone, Copy, Debug)]
+pub struct ChainConstants {
+    /// Fraction of the way to the shape-matching goals per iteration.
+    pub alpha_per_iteration: f32,
+    /// `exp(-damping * h)`.
+    pub velocity_decay: f32,
+    pub gravity: Vec3,
+    /// `a^2 / 5`: weight of particle orientations in the group matrix.
+    pub orientation_weight: f32,
+}
+
+impl ChainConstants {
+    pub fn new(params: &ChainParams, settings: &EngineSettings, h: f32, iterations: u32) -> Self {
+        Self {
+            alpha_per_iteration: params.alpha_per_iteration(h, iterations),
+            velocity_decay: (-params.damping * h).exp(),
+            gravity: settings.gravity * (params.gravity_scale * settings.scale),
+            orientation_weight: (params.radius * settings.scale).powi(2) / 5.0,
+        }
+    }
+}
+
 /// Everything a substep needs besides the state.
 pub struct SubstepInput<'a> {
     pub h: f32,
     /// The anchor at the end of this substep, relative to the engine origin.
     pub anchor: Transform,
-    pub gravity: Vec3,
-    /// `exp(-damping * h)`.
-    pub velocity_decay: f32,
-    /// Fraction of the way to the shape-matching goals per iteration.
-    pub alpha_per_iteration: f32,
+    pub constants: ChainConstants,
     pub iterations: u32,
-    /// `a^2 / 5`: weight of particle orientations in the group matrix.
-    pub orientation_weight: f32,
     pub rest: &'a Shape,
     /// Derived from `rest`.
     pub rest_groups: &'a RestGroups,
@@ -173,13 +191,13 @@ pub fn substep(
     let root_velocity = ((p[0] - state.x[0]) / h as f64).as_vec3();
     for i in 1..n {
         let relative = state.v[i] - root_velocity;
-        state.v[i] = root_velocity + relative * input.velocity_decay + input.gravity * kick;
-        state.w[i] *= input.velocity_decay;
+        state.v[i] = root_velocity + relative * input.constants.velocity_decay + input.constants.gravity * kick;
+        state.w[i] *= input.constants.velocity_decay;
         p[i] = state.x[i] + (state.v[i] * h).as_dvec3();
         qp[i] = (exp_small(state.w[i] * h) * state.q[i]).normalize();
     }
 
-    let alpha = input.alpha_per_iteration;
+    let alpha = input.constants.alpha_per_iteration;
     let iterations = if alpha > 0.0 { input.iterations.max(1) } else { 1 };
     let mut report = SubstepReport::default();
     for iteration in 0..iterations {
@@ -190,7 +208,7 @@ pub fn substep(
                 qp,
                 input.rest,
                 input.rest_groups,
-                input.orientation_weight,
+                input.constants.orientation_weight,
                 alpha,
             );
         }

@@ -6,7 +6,7 @@ use glam::{DVec3, Quat, Vec3, Vec3A};
 use super::simd::{D, DV3, F, Mask, Q, V3};
 use crate::core::inextensible::ConstraintScratch;
 use crate::core::math::Transform;
-use crate::core::rod::RodState;
+use crate::core::rod::{ChainConstants, RodState};
 use crate::core::shape::Shape;
 
 /// What one chain brings to a lane group for one step.
@@ -16,10 +16,7 @@ pub(crate) struct LaneChain<'a> {
     /// `RestGroups` offsets of `rest`.
     pub offsets: &'a [[Vec3A; 3]],
     pub lengths: &'a [f32],
-    pub alpha_per_iteration: f32,
-    pub velocity_decay: f32,
-    pub gravity: Vec3,
-    pub orientation_weight: f32,
+    pub constants: &'a ChainConstants,
     pub half_kick: bool,
 }
 
@@ -162,10 +159,11 @@ impl<const L: usize> LaneGroup<L> {
             self.length_squared[k].0[lane] = l2;
             self.inverse_length_squared[k].0[lane] = 1.0 / l2;
         }
-        self.alpha.0[lane] = chain.alpha_per_iteration;
-        self.decay.0[lane] = chain.velocity_decay;
-        self.gravity.set(lane, chain.gravity.to_array());
-        self.orientation_weight.0[lane] = chain.orientation_weight;
+        let constants = chain.constants;
+        self.alpha.0[lane] = constants.alpha_per_iteration;
+        self.decay.0[lane] = constants.velocity_decay;
+        self.gravity.set(lane, constants.gravity.to_array());
+        self.orientation_weight.0[lane] = constants.orientation_weight;
         self.half_kick.0[lane] = chain.half_kick;
     }
 

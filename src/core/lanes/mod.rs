@@ -27,6 +27,7 @@ use multiversion::multiversion;
 use super::arena::Arena;
 use super::chain::Chain;
 use super::math::Transform;
+use super::rod::ChainConstants;
 use group::{GroupSettings, LaneChain, LaneGroup};
 use simd::Mask;
 
@@ -69,17 +70,14 @@ pub(crate) struct LaneJob {
     /// The anchor at the start and at the end of the step (relative to the engine origin).
     pub start: Transform,
     pub target: Transform,
-    pub alpha_per_iteration: f32,
-    pub velocity_decay: f32,
-    pub gravity: glam::Vec3,
-    pub orientation_weight: f32,
+    pub constants: ChainConstants,
     /// Nothing about the chain changed this step (towards sleeping).
     pub still: bool,
 }
 
 impl LaneJob {
     fn key(&self) -> (usize, bool) {
-        (self.joints, self.alpha_per_iteration > 0.0)
+        (self.joints, self.constants.alpha_per_iteration > 0.0)
     }
 }
 
@@ -179,7 +177,7 @@ fn run_group<const L: usize>(
         joints: first.joints,
         h: clock.h,
         iterations: clock.iterations,
-        shape_matching: first.alpha_per_iteration > 0.0,
+        shape_matching: first.constants.alpha_per_iteration > 0.0,
         substeps,
     });
     let anchor = |job: &LaneJob, s: usize| job.start.interpolate(&job.target, clock.progress[s]);
@@ -192,10 +190,7 @@ fn run_group<const L: usize>(
                 rest: &chain.rest,
                 offsets: &chain.rest_groups.offsets,
                 lengths: &chain.frame.lengths,
-                alpha_per_iteration: job.alpha_per_iteration,
-                velocity_decay: job.velocity_decay,
-                gravity: job.gravity,
-                orientation_weight: job.orientation_weight,
+                constants: &job.constants,
                 half_kick: chain.half_kick,
             },
         );

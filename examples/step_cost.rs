@@ -6,7 +6,7 @@
 //! cheapest case: nothing bends or turns), and a head swaying 0.2 m at 1 Hz, where every chain bends and
 //! every solver iteration does real work.
 //!
-//! `cargo run --release --example step_cost -- CHAINS JOINTS FRAMES [still|sway]` runs one scene once for
+//! `cargo run --release --example step_cost -- CHAINS JOINTS FRAMES [still|sway] [LENGTH]` runs one scene once for
 //! a fixed workload (after one warm-up frame), for instruction counts, e.g.
 //! `valgrind --tool=callgrind target/release/examples/step_cost 10 16 50 sway`; divide `Engine::step`'s
 //! inclusive count by `CHAINS * (JOINTS - 1)` and by the substeps of all frames, warm-up included (printed).
@@ -16,14 +16,17 @@ use std::time::Instant;
 use glam::{Quat, Vec3};
 use kodawari::{ChainParams, Engine, EngineSettings, Transform};
 
-fn scene(chains: usize, joints: usize) -> Engine {
+/// Segment length of the default scenes (m).
+const SPACING: f32 = 0.03;
+
+fn scene(chains: usize, joints: usize, spacing: f32) -> Engine {
     let mut engine = Engine::new(EngineSettings::default()).expect("default settings are valid");
     // `KDW_SOLVER=scalar` measures the scalar reference solver instead of the lane solver.
     if std::env::var("KDW_SOLVER").is_ok_and(|s| s == "scalar") {
         engine.set_solver(kodawari::Solver::Scalar);
     }
     let base: Vec<Transform> =
-        (0..joints).map(|i| Transform::new(Vec3::new(0.0, 0.1 + 0.03 * i as f32, 0.0), Quat::IDENTITY)).collect();
+        (0..joints).map(|i| Transform::new(Vec3::new(0.0, 0.1 + spacing * i as f32, 0.0), Quat::IDENTITY)).collect();
     for _ in 0..chains {
         engine.create_chain(ChainParams::default(), &base).expect("valid chain");
     }
@@ -44,7 +47,7 @@ fn run(engine: &mut Engine, frames: std::ops::Range<usize>, sway: bool) {
 
 /// Median seconds per frame over 7 rounds.
 fn time_per_frame(chains: usize, joints: usize, sway: bool) -> (f64, f64) {
-    let mut engine = scene(chains, joints);
+    let mut engine = scene(chains, joints, SPACING);
     let frames = (2_000_000 / (chains * joints)).clamp(60, 2000);
     let mut per_frame = Vec::new();
     for round in 0..7 {
@@ -62,15 +65,21 @@ fn main() {
         let number = |i: usize| args[i].parse::<usize>().expect("usage: step_cost CHAINS JOINTS FRAMES [still|sway]");
         let (chains, joints, frames) = (number(0), number(1), number(2));
         let sway = args.get(3).is_some_and(|m| m == "sway");
-        let mut engine = scene(chains, joints);
+        // An optional fifth argument, the chain length in metres, makes fine ropes (e.g. 1000 joints in 0.8 m,
+        // the performance report's 1 x 1000 scene).
+        let spacing = args.get(4).map_or(SPACING, |l| l.parse::<f32>().expect("chain length in m") / (joints - 1) as f32);
+        let mut engine = scene(chains, joints, spacing);
         let start = Instant::now();
         run(&mut engine, 0..frames + 1, sway);
         let elapsed = start.elapsed().as_secs_f64();
-        let substeps = engine.stats().substeps_total;
+        let stats = engine.stats();
+        let substeps = stats.substeps_total;
         println!(
-            "{chains} chains x {joints} joints, {} frames ({}), {substeps} substeps: {:.0} ns/joint/substep",
+            "{chains} chains x {joints} joints, {} frames ({}), {substeps} substeps, {} solver fallbacks: \
+             {:.0} ns/joint/substep",
             frames + 1,
             if sway { "sway" } else { "still" },
+            stats.solver_fallbacks,
             elapsed * 1e9 / ((chains * (joints - 1)) as f64 * substeps as f64),
         );
         return;

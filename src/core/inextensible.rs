@@ -204,6 +204,9 @@ fn newton_along_directions(
             }
             return true;
         }
+        if pass.diverging(previous_worst) {
+            return false;
+        }
         previous_worst = pass.worst;
         if !pass.pivots_usable() {
             return false;
@@ -301,6 +304,13 @@ impl ForwardPass {
     /// error of the one before has reached it. (The system is solved in f64: its condition grows like n^2.)
     fn converged(&self, previous_worst: f64) -> bool {
         self.worst <= TOLERANCE || (self.worst > 0.5 * previous_worst && self.worst < STAGNATION_LIMIT)
+    }
+
+    /// The error grew (and is above the rounding floor, or the pass would count as converged): the direct
+    /// solve is going astray. On the fine ropes of bug 1 (docs/robustness.md) every failing solve grew its
+    /// error in its first iterations and none that grew converged, so giving up there saves the rest.
+    fn diverging(&self, previous_worst: f64) -> bool {
+        self.worst > previous_worst
     }
 
     /// No pivot vanished (relative to the largest diagonal entry); false for NaN too.

@@ -266,8 +266,8 @@ fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>) -> Mask<L> {
             solved = solved.or(converged);
             active = active.and(converged.not());
         }
+        active = active.and(pass.diverging(previous_worst).not()).and(pass.pivots_usable());
         previous_worst = pass.worst;
-        active = active.and(pass.pivots_usable());
         if !active.any() {
             break;
         }
@@ -342,6 +342,11 @@ impl<const L: usize> ForwardPass<L> {
     fn converged(&self, previous_worst: D<L>) -> Mask<L> {
         let floor = self.worst.gt(previous_worst * 0.5).and(self.worst.lt(D::splat(STAGNATION_LIMIT)));
         self.worst.le(D::splat(TOLERANCE)).or(floor)
+    }
+
+    #[inline(always)]
+    fn diverging(&self, previous_worst: D<L>) -> Mask<L> {
+        self.worst.gt(previous_worst)
     }
 
     #[inline(always)]

@@ -307,8 +307,9 @@ impl ForwardPass {
     }
 
     /// The error grew (and is above the rounding floor, or the pass would count as converged): the direct
-    /// solve is going astray. On the fine ropes of bug 1 (docs/robustness.md) every failing solve grew its
-    /// error in its first iterations and none that grew converged, so giving up there saves the rest.
+    /// solve is going astray. Measured on bug 1's ropes (docs/robustness.md, 200 and 1000 joints): of 665
+    /// solves whose error grew, 630 failed after all their iterations and 35 ended at the stagnation floor
+    /// (errors of 1e-4 to 1e-3, far above the tolerance), which the converging fallback now handles instead.
     fn diverging(&self, previous_worst: f64) -> bool {
         self.worst > previous_worst
     }

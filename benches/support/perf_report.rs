@@ -407,7 +407,7 @@ pub fn micros(seconds: Option<f64>) -> String {
     }
 }
 
-fn ns(value: Option<f64>) -> String {
+pub fn ns(value: Option<f64>) -> String {
     value.map_or_else(|| "not run".into(), |v| format!("{v:.0}"))
 }
 
@@ -602,21 +602,39 @@ impl Report {
     }
 
     fn linearity_section(&self, md: &mut String) {
-        md.push_str("## Linearity\n\nns/joint/substep of the plain scenes (no view shapes, no colliders):\n\n");
-        md.push_str("| scene | dynamic joints | ns/joint/substep | / 1000 x 16 |\n|---|---|---|---|\n");
-        let reference = self.scene("1000x16", "plain").and_then(SceneRow::ns_per_joint_substep);
+        md.push_str(
+            "## Linearity\n\nns/joint/substep of the plain scenes (no view shapes, no colliders) on both solvers, \
+             relative to 1000 x 16 on the same solver, and the share of chain-substeps whose direct \
+             inextensibility solve fell back (`Stats::solver_fallbacks`; a lone chain takes the scalar solver \
+             either way):\n\n",
+        );
+        md.push_str(
+            "| scene | dynamic joints | lanes ns/joint/substep | / 1000 x 16 | scalar ns/joint/substep | / 1000 x 16 | \
+             fallbacks |\n|---|---|---|---|---|---|---|\n",
+        );
+        let per_joint = |scene: &str, variant: &str| self.scene(scene, variant).and_then(SceneRow::ns_per_joint_substep);
+        let relative = |x: Option<f64>, y: Option<f64>| match (x, y) {
+            (Some(x), Some(y)) => format!("{:.2}", x / y),
+            _ => "-".into(),
+        };
+        let (lanes_reference, scalar_reference) = (per_joint("1000x16", "plain"), per_joint("1000x16", "plain_scalar"));
         for r in self.scenes.iter().filter(|r| r.variant == "plain") {
-            let relative = match (r.ns_per_joint_substep(), reference) {
-                (Some(x), Some(y)) => format!("{:.2}", x / y),
-                _ => "-".into(),
-            };
+            let lanes = r.ns_per_joint_substep();
+            let scalar = per_joint(r.scene, "plain_scalar");
+            let fallbacks = r.counters.as_ref().map_or("-".into(), |c| {
+                let chain_substeps = (r.chains as f64) * (r.substeps.max(1) as f64);
+                format!("{:.0}%", 100.0 * c.solver_fallbacks / chain_substeps)
+            });
             let _ = writeln!(
                 md,
-                "| {} ({}) | {} | {} | {relative} |",
+                "| {} ({}) | {} | {} | {} | {} | {} | {fallbacks} |",
                 r.scene,
                 r.shape,
                 r.dynamic_joints,
-                ns(r.ns_per_joint_substep())
+                ns(lanes),
+                relative(lanes, lanes_reference),
+                ns(scalar),
+                relative(scalar, scalar_reference),
             );
         }
         md.push('\n');

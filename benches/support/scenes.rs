@@ -49,15 +49,23 @@ pub struct Scene {
     pub name: &'static str,
     pub chains: usize,
     pub joints: JointCounts,
+    /// Segment length (m); `None`: hair segments, with long chains capped at `LONG_CHAIN_LENGTH` in total.
+    pub segment: Option<f32>,
 }
 
 impl Scene {
     pub const fn uniform(name: &'static str, chains: usize, joints: usize) -> Self {
-        Self { name, chains, joints: JointCounts::Uniform(joints) }
+        Self { name, chains, joints: JointCounts::Uniform(joints), segment: None }
     }
 
     pub const fn ragged(name: &'static str, chains: usize, min: usize, max: usize) -> Self {
-        Self { name, chains, joints: JointCounts::Ragged { min, max } }
+        Self { name, chains, joints: JointCounts::Ragged { min, max }, segment: None }
+    }
+
+    /// The same chains with segments of `segment` m, whatever their joint count (a 1000-joint chain of hair
+    /// segments is a 25 m rope rather than a 0.8 m one of 0.8 mm segments).
+    pub const fn with_segment(self, segment: f32) -> Self {
+        Self { segment: Some(segment), ..self }
     }
 
     pub fn joint_counts(&self) -> Vec<usize> {
@@ -79,11 +87,15 @@ impl Scene {
         self.joint_counts().iter().map(|n| n - 1).sum()
     }
 
-    /// "1000 x 16" or "200 x 4-32".
+    /// "1000 x 16", "200 x 4-32" or "1 x 1000, 2.5 cm segments".
     pub fn shape_label(&self) -> String {
-        match self.joints {
+        let counts = match self.joints {
             JointCounts::Uniform(n) => format!("{} x {n}", self.chains),
             JointCounts::Ragged { min, max } => format!("{} x {min}-{max}", self.chains),
+        };
+        match self.segment {
+            Some(segment) => format!("{counts}, {} cm segments", segment * 100.0),
+            None => counts,
         }
     }
 }
@@ -205,6 +217,7 @@ pub const LIMP: Variant = Variant { id: "limp", label: "limp (stiffness 0)", sti
 /// Which character each chain belongs to, and the chain's place among its character's strands.
 pub struct Layout {
     pub joint_counts: Vec<usize>,
+    segment: Option<f32>,
     pub character_of: Vec<usize>,
     pub characters: usize,
 }
@@ -213,7 +226,8 @@ impl Layout {
     pub fn new(scene: &Scene) -> Self {
         let joint_counts = scene.joint_counts();
         let character_of = (0..scene.chains).map(|i| i / CHAINS_PER_CHARACTER).collect();
-        Self { joint_counts, character_of, characters: scene.chains.div_ceil(CHAINS_PER_CHARACTER) }
+        let characters = scene.chains.div_ceil(CHAINS_PER_CHARACTER);
+        Self { joint_counts, segment: scene.segment, character_of, characters }
     }
 
     /// Strands of chain `i`'s character, and `i`'s index among them.
@@ -228,28 +242,28 @@ impl Layout {
     pub fn shapes(&self, i: usize, view_shapes: usize) -> (Vec<Transform>, Vec<(Vec3, Vec<Transform>)>) {
         let (index, count) = self.place_on_scalp(i);
         let joints = self.joint_counts[i];
-        let base = strand(index, count, joints, -Vec3::Y);
+        let segment = self.segment.unwrap_or(HAIR_SEGMENT.min(LONG_CHAIN_LENGTH / (joints - 1) as f32));
+        let base = strand(index, count, joints, segment, -Vec3::Y);
         // Seen from the left the strand curls to the left, from the right to the right, from the front
         // toward the viewer: the shapes an artist would sketch so the silhouette reads from each side.
         let views = [(-Vec3::X, -Vec3::X), (Vec3::X, Vec3::X), (Vec3::Z, Vec3::Z)];
         let views = views[..view_shapes.min(3)]
             .iter()
-            .map(|&(from, lean)| (from, strand(index, count, joints, (-Vec3::Y + 0.8 * lean).normalize())))
+            .map(|&(from, lean)| (from, strand(index, count, joints, segment, (-Vec3::Y + 0.8 * lean).normalize())))
             .collect();
         (base, views)
     }
 }
 
 /// Strand `index` of `count` on the upper half of the scalp (Fibonacci spiral), `joints` joints growing
-/// out of the scalp and bending toward `droop`. Joint rotations turn the bone axis (+Y) onto the next
+/// out of the scalp, `segment` m apart, and bending toward `droop`. Joint rotations turn the bone axis (+Y) onto the next
 /// segment, as in a typical rig. Segment lengths do not depend on `droop`, as view shapes require.
-pub fn strand(index: usize, count: usize, joints: usize, droop: Vec3) -> Vec<Transform> {
+pub fn strand(index: usize, count: usize, joints: usize, segment: f32, droop: Vec3) -> Vec<Transform> {
     let golden_angle = PI * (3.0 - 5f32.sqrt());
     let height = 1.0 - (index as f32 + 0.5) / count as f32;
     let ring = (1.0 - height * height).sqrt();
     let azimuth = golden_angle * index as f32;
     let mut direction = Vec3::new(ring * azimuth.cos(), height, ring * azimuth.sin());
-    let segment = HAIR_SEGMENT.min(LONG_CHAIN_LENGTH / (joints - 1) as f32);
     let mut position = direction * SCALP_RADIUS;
     let mut out = Vec::with_capacity(joints);
     for _ in 0..joints {

@@ -567,7 +567,9 @@ fn targets(report: &Report) -> Vec<Target> {
     let many = ns_per_joint(report, "1000x16", PLAIN_SCALAR.id);
     let hair = ns_per_joint(report, LINEARITY_SCENE.name, PLAIN_SCALAR.id);
     let fallbacks = |scene: &str| {
-        report.scene(scene, PLAIN_SCALAR.id).and_then(|r| Some(r.counters.as_ref()?.solver_fallbacks / r.substeps.max(1) as f64))
+        report
+            .scene(scene, PLAIN_SCALAR.id)
+            .and_then(|r| Some(r.counters.as_ref()?.solver_fallbacks / r.substeps.max(1) as f64))
     };
     let linearity = long.zip(many).map(|(l, m)| l / m);
     out.push(Target::check(

@@ -67,7 +67,8 @@ fn main() {
         let sway = args.get(3).is_some_and(|m| m == "sway");
         // An optional fifth argument, the chain length in metres, makes fine ropes (e.g. 1000 joints in 0.8 m,
         // the performance report's 1 x 1000 scene).
-        let spacing = args.get(4).map_or(SPACING, |l| l.parse::<f32>().expect("chain length in m") / (joints - 1) as f32);
+        let spacing =
+            args.get(4).map_or(SPACING, |l| l.parse::<f32>().expect("chain length in m") / (joints - 1) as f32);
         let mut engine = scene(chains, joints, spacing);
         let start = Instant::now();
         run(&mut engine, 0..frames + 1, sway);

@@ -612,7 +612,8 @@ impl Report {
             "| scene | dynamic joints | lanes ns/joint/substep | / 1000 x 16 | scalar ns/joint/substep | / 1000 x 16 | \
              fallbacks |\n|---|---|---|---|---|---|---|\n",
         );
-        let per_joint = |scene: &str, variant: &str| self.scene(scene, variant).and_then(SceneRow::ns_per_joint_substep);
+        let per_joint =
+            |scene: &str, variant: &str| self.scene(scene, variant).and_then(SceneRow::ns_per_joint_substep);
         let relative = |x: Option<f64>, y: Option<f64>| match (x, y) {
             (Some(x), Some(y)) => format!("{:.2}", x / y),
             _ => "-".into(),

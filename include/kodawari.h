@@ -35,6 +35,21 @@
 // A teleport puts the chain back to its rest shape under the new anchor, at rest.
 #define KDW_TELEPORT_RESET 1
 
+// The lane solver (the default): chains of equal joint count are stepped side by side, one chain per SIMD
+// lane, with the widest kernel copy this CPU has (`kdw_simd_path`). Chains that may touch a collider, and
+// the last 1 to 3 chains of a joint count (too few for a group), take the scalar solver in a step. It agrees
+// with `KDW_SOLVER_SCALAR` up to float rounding; a chain's bits do not depend on its lane, its group or the
+// kernel copy.
+#define KDW_SOLVER_LANES 0
+
+// `KDW_SOLVER_LANES` with the portable copy of its kernel (SSE2 on x86-64) whatever the CPU has: the same
+// bits, slower. For checking the determinism policy on one machine.
+#define KDW_SOLVER_LANES_PORTABLE 1
+
+// One chain at a time: the reference implementation the lane solver is tested against (and what chains near
+// colliders always use).
+#define KDW_SOLVER_SCALAR 2
+
 // The chain's anchor is the view reference joint K given with each step.
 #define KDW_ANCHOR_VIEW_REFERENCE 0
 
@@ -57,8 +72,9 @@
 // Keeps particles inside a capsule.
 #define KDW_COLLIDER_INSIDE_CAPSULE 4
 
-// Bumped on every incompatible change of the C ABI (signatures, struct layouts, semantics).
-#define KDW_ABI_VERSION 2
+// Bumped on every incompatible change of the C ABI (signatures, struct layouts, semantics). 3: solver
+// selection, `kdw_engine_stats.lane_chains`.
+#define KDW_ABI_VERSION 3
 
 // One per character: owns chains and view shapes, gravity and solver settings. Opaque.
 typedef struct kdw_engine kdw_engine;
@@ -189,7 +205,12 @@ typedef struct kdw_engine_stats {
     uint32_t substeps_last_step;
     // Chains that cost nothing in the last step (sleeping or disabled).
     uint32_t chains_asleep;
+    // Chains the lane solver stepped in the last `kdw_engine_step`; the others ran on the scalar solver or
+    // were asleep or disabled. 0 on `KDW_SOLVER_SCALAR`.
+    uint32_t lane_chains;
     uint32_t collider_count;
+    // Always 0: keeps the 64-bit fields that follow aligned without hidden padding.
+    uint32_t reserved;
     uint64_t substeps_total;
     // Internal steps where the direct inextensibility solve failed and a fallback ran.
     uint64_t solver_fallbacks;
@@ -428,6 +449,15 @@ kdw_status kdw_engine_set_def(struct kdw_engine *engine, const struct kdw_engine
 // Sets world gravity, m/s².
 kdw_status kdw_engine_set_gravity(struct kdw_engine *engine, const struct kdw_vec3 *gravity);
 
+// Selects the solver for the chains that touch no collider: `KDW_SOLVER_LANES` (the default),
+// `KDW_SOLVER_LANES_PORTABLE` or `KDW_SOLVER_SCALAR`. They agree up to float rounding; the choice is part of
+// `kdw_engine_state_hash`. Any other value is rejected with `KDW_STATUS_INVALID_ARGUMENT` and changes nothing.
+kdw_status kdw_engine_set_solver(struct kdw_engine *engine,
+                                 uint32_t solver);
+
+// The engine's solver: one of `KDW_SOLVER_*`.
+kdw_status kdw_engine_get_solver(const struct kdw_engine *engine, uint32_t *out_solver);
+
 // Advances every chain by `dt` seconds (scaled by the time scale) in fixed internal steps. `camera_position`
 // and `view_reference` (the joint K the view direction is measured from; also the anchor of chains with
 // `KDW_ANCHOR_VIEW_REFERENCE`) are in world space. `dt` must be finite and >= 0; `dt == 0` changes
@@ -487,7 +517,7 @@ kdw_status kdw_engine_read_local_rotations(const struct kdw_engine *engine,
                                            uint32_t capacity,
                                            uint32_t *out_written);
 
-// Counters: chains, joints, substeps run, time dropped, chains asleep.
+// Counters: chains, joints, substeps run, time dropped, chains asleep, chains on the lane solver.
 kdw_status kdw_engine_get_stats(const struct kdw_engine *engine, struct kdw_engine_stats *out_stats);
 
 // Puts every chain back to its rest shape, at rest, at the next step.
@@ -556,6 +586,11 @@ uint32_t kdw_abi_version(void);
 
 // The library's version, e.g. "0.1.0": static, NUL-terminated, never NULL.
 const char *kdw_version_string(void);
+
+// The instruction set `KDW_SOLVER_LANES` runs its kernel with on this CPU: "avx2", "sse2" (the portable
+// x86-64 kernel), "neon" (aarch64) or "scalar" (no SIMD kernel for this architecture).
+// `KDW_SOLVER_LANES_PORTABLE` always runs the portable kernel. Static, NUL-terminated, never NULL.
+const char *kdw_simd_path(void);
 
 // Adds a view shape to a chain: when the camera is seen from `direction` (in the view reference joint's
 // local frame; need not be unit, must not be zero), the chain's rest shape becomes `joints` (anchor frame,

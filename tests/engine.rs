@@ -1,11 +1,11 @@
 //! Engine behaviour through the Rust API: ids, validation that leaves the state untouched, time handling,
-//! teleports, reset, stiffness independence from the solver settings.
+//! teleports, reset, stiffness independence from the solver settings, the solver choice in the state hash.
 
 mod common;
 
 use common::*;
 use glam::{Quat, Vec3};
-use kodawari::{AnchorSource, ChainId, ChainParams, Engine, EngineSettings, ErrorKind, Transform};
+use kodawari::{AnchorSource, ChainId, ChainParams, Engine, EngineSettings, ErrorKind, Solver, Transform};
 
 const HEAD: Vec3 = Vec3::new(0.0, 1.6, 0.0);
 const CAMERA: Vec3 = Vec3::new(0.0, 1.7, 3.0);
@@ -104,6 +104,24 @@ fn identical_runs_are_bit_identical() {
     assert_eq!(a.state_hash(), b.state_hash());
     a.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
     assert_ne!(a.state_hash(), b.state_hash());
+}
+
+/// The solver choice is state (it changes results by rounding): engines that differ only in it hash apart, and
+/// switching back restores the hash.
+#[test]
+fn solver_is_part_of_the_state_hash() {
+    let (mut a, _) = scene();
+    let hash = a.state_hash();
+    assert_eq!(a.solver(), Solver::Lanes, "the default");
+    let mut seen = vec![hash];
+    for solver in [Solver::LanesPortable, Solver::Scalar] {
+        a.set_solver(solver);
+        assert_eq!(a.solver(), solver);
+        assert!(!seen.contains(&a.state_hash()), "{solver:?} hashes like another solver");
+        seen.push(a.state_hash());
+    }
+    a.set_solver(Solver::Lanes);
+    assert_eq!(a.state_hash(), hash);
 }
 
 #[test]

@@ -806,6 +806,32 @@ fn cases(fx: &Fixture) -> Vec<Case> {
             Box::new(move |fx| (kdw_engine_set_gravity(fx.a, &g), true)),
         ));
     }
+    c.push(case(
+        "kdw_engine_set_solver",
+        "null:engine",
+        nullp,
+        Box::new(|_| (kdw_engine_set_solver(null_mut(), KDW_SOLVER_SCALAR), true)),
+    ));
+    for solver in [3u32, u32::MAX] {
+        c.push(case(
+            "kdw_engine_set_solver",
+            format!("range:solver={solver}"),
+            badarg,
+            Box::new(move |fx| (kdw_engine_set_solver(fx.a, solver), true)),
+        ));
+    }
+    c.push(case(
+        "kdw_engine_get_solver",
+        "null:engine",
+        nullp,
+        Box::new(|_| out(SENTINEL_U32, |o| kdw_engine_get_solver(null(), o))),
+    ));
+    c.push(case(
+        "kdw_engine_get_solver",
+        "null:out_solver",
+        nullp,
+        Box::new(|fx| (kdw_engine_get_solver(fx.a, null_mut()), true)),
+    ));
 
     // -- step
     c.push(case(
@@ -2139,6 +2165,7 @@ fn special_tags() -> BTreeMap<&'static str, Vec<String>> {
         "kdw_engine_def_default",
         "kdw_abi_version",
         "kdw_version_string",
+        "kdw_simd_path",
         "kdw_status_str",
         "kdw_stroke_camera_default",
         "kdw_collider_def_default",
@@ -2308,6 +2335,10 @@ fn constant_queries() {
     // SAFETY: static NUL-terminated string.
     let version = unsafe { CStr::from_ptr(kdw_version_string()) }.to_str().unwrap();
     assert_eq!(version, env!("CARGO_PKG_VERSION"));
+    // SAFETY: static NUL-terminated string.
+    let simd = unsafe { CStr::from_ptr(kdw_simd_path()) }.to_str().unwrap();
+    assert!(["avx2", "sse2", "neon", "scalar"].contains(&simd), "kdw_simd_path() = {simd:?}");
+    assert_eq!(simd, kodawari::simd_path());
     assert_eq!(kdw_engine_def_default().struct_size as usize, size_of::<kdw_engine_def>());
     assert_eq!(kdw_chain_def_default().struct_size as usize, size_of::<kdw_chain_def>());
     assert_eq!(kdw_collider_def_default().struct_size as usize, size_of::<kdw_collider_def>());

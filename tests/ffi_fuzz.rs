@@ -1,7 +1,8 @@
 //! API fuzzing through the C ABI (SPEC 6.2): random sequences of C calls — create/destroy engines, chains
 //! (0..40 joints, random and invalid floats), view shapes, colliders (random shapes, sizes, poses, layers;
 //! batched pose updates with random counts), per-joint radii, teleports, anchors with random counts, steps
-//! with random (also invalid) dt, reads with random capacities, resets, def changes — driven by proptest with
+//! with random (also invalid) dt, reads with random capacities, resets, def changes, solver switches (also to
+//! unknown values) — driven by proptest with
 //! a fixed ChaCha seed, so CI runs are reproducible.
 //!
 //! Invariants: no call returns `KDW_STATUS_PANIC`; every successful read returns finite values; issued ids
@@ -366,7 +367,17 @@ impl World {
                 };
                 let k = transform(c.f, c.pick2 % 5 != 0, self.untamed);
                 let camera = if c.pick2 % 7 == 0 { vec3(tame(c.f[3]), 0.0, c.f[1]) } else { vec3(0.0, 1.7, 3.0) };
-                kdw_engine_step(engine, dt, &camera, &k)
+                let s = kdw_engine_step(engine, dt, &camera, &k);
+                if s == KDW_STATUS_OK && dt > 0.0 {
+                    // This step's counters: chains in lanes are awake, and the scalar solver puts none in lanes.
+                    let mut stats = kdw_engine_stats::default();
+                    prop_assert_eq!(kdw_engine_get_stats(engine, &mut stats), KDW_STATUS_OK);
+                    let mut solver = u32::MAX;
+                    prop_assert_eq!(kdw_engine_get_solver(engine, &mut solver), KDW_STATUS_OK);
+                    prop_assert!(stats.lane_chains + stats.chains_asleep <= stats.chain_count, "{:?}", stats);
+                    prop_assert!(solver != KDW_SOLVER_SCALAR || stats.lane_chains == 0, "lanes on the scalar solver");
+                }
+                s
             }
             15 | 16 => {
                 let joints = Self::joint_count(engine);
@@ -450,7 +461,23 @@ impl World {
                 }
                 kdw_chain_set_def(engine, self.chain_id(e, c.pick2), &def)
             }
-            21 => kdw_engine_set_gravity(engine, &vec3(tame(c.f[0] * 20.0), tame(c.f[1] * 20.0), tame(c.f[2]))),
+            21 => {
+                if c.pick % 8 == 0 {
+                    // Switch solver between steps: the three KDW_SOLVER_* values and an unknown one.
+                    let solver = (c.pick2 % 4) as u32;
+                    let s = kdw_engine_set_solver(engine, solver);
+                    let mut now = u32::MAX;
+                    prop_assert_eq!(kdw_engine_get_solver(engine, &mut now), KDW_STATUS_OK);
+                    if solver <= KDW_SOLVER_SCALAR {
+                        prop_assert!(s == KDW_STATUS_OK && now == solver, "set_solver({}): {}, now {}", solver, s, now);
+                    } else {
+                        prop_assert_eq!(s, KDW_STATUS_INVALID_ARGUMENT, "set_solver({})", solver);
+                    }
+                    s
+                } else {
+                    kdw_engine_set_gravity(engine, &vec3(tame(c.f[0] * 20.0), tame(c.f[1] * 20.0), tame(c.f[2])))
+                }
+            }
             22 => {
                 let chain = self.chain_id(e, c.pick2);
                 let mut n = 0;

@@ -7,6 +7,7 @@
 //   kodawari::EngineDef / ChainDef / ColliderDef  the C def structs, initialised to the library defaults
 //   kodawari::StrokeCamera, shapeFromStroke()  the sketch tool: a screen-space stroke -> a chain shape
 //   kodawari::stepEngines()               steps many engines in one call (kdw_engines_step)
+//   kodawari::Solver, simdPath()          Engine::setSolver's choices; the lane solver's instruction set
 //
 // Errors: by default every failing call throws kodawari::Error (status + the library's message). Define
 // KODAWARI_NO_EXCEPTIONS before including this header to get no throws at all: the same methods then
@@ -65,6 +66,22 @@ inline uint32_t abiVersion() noexcept { return kdw_abi_version(); }
 
 /// The library's version string, e.g. "0.1.0".
 inline const char* versionString() noexcept { return kdw_version_string(); }
+
+/// The instruction set the lane solver's kernel runs with on this CPU: "avx2", "sse2" (the portable
+/// x86-64 kernel), "neon" or "scalar". Static, never null.
+inline const char* simdPath() noexcept { return kdw_simd_path(); }
+
+/// Which solver steps an engine's chains that touch no collider (KDW_SOLVER_*). They agree up to float
+/// rounding; a chain's bits never depend on its lane, its group or the kernel copy.
+enum class Solver : uint32_t {
+    /// Chains of equal joint count side by side in SIMD lanes (the default). Chains near colliders and the
+    /// last 1 to 3 chains of a joint count (too few for a group) take the scalar solver.
+    Lanes = KDW_SOLVER_LANES,
+    /// Lanes with the portable kernel copy whatever the CPU has: the same bits, slower (determinism checks).
+    LanesPortable = KDW_SOLVER_LANES_PORTABLE,
+    /// One chain at a time: the reference implementation.
+    Scalar = KDW_SOLVER_SCALAR,
+};
 
 /// A static description of a status.
 inline const char* statusString(kdw_status status) noexcept {
@@ -632,6 +649,17 @@ public:
     }
     /// Sets world gravity, m/s².
     Ret<void> setGravity(const Vec3& gravity) { return detail::check(kdw_engine_set_gravity(handle_, &gravity)); }
+    /// Selects the solver for the chains that touch no collider (Solver::Lanes by default); part of stateHash().
+    /// A value outside Solver fails with KDW_STATUS_INVALID_ARGUMENT and changes nothing.
+    Ret<void> setSolver(Solver solver) {
+        return detail::check(kdw_engine_set_solver(handle_, static_cast<uint32_t>(solver)));
+    }
+    /// The engine's solver.
+    [[nodiscard]] Ret<Solver> solver() const {
+        uint32_t solver = 0;
+        const kdw_status status = kdw_engine_get_solver(handle_, &solver);
+        return detail::result(status, static_cast<Solver>(solver));
+    }
 
     /// Advances every chain by `dt` s (finite, >= 0), seen from `camera` (world), with the view reference
     /// joint K at `viewReference` (world).
@@ -704,7 +732,8 @@ public:
         return detail::result(status, written);
     }
 
-    /// Counters: chains, joints, substeps, time dropped, chains asleep.
+    /// Counters: chains, joints, substeps, time dropped, chains asleep, chains the lane solver stepped
+    /// (lane_chains) in the last step.
     [[nodiscard]] Ret<EngineStats> stats() const {
         EngineStats stats{};
         const kdw_status status = kdw_engine_get_stats(handle_, &stats);

@@ -246,6 +246,20 @@ namespace Kodawari.Native
         internal static extern int kdw_engine_set_gravity(kdw_engine* engine, kdw_vec3* gravity);
 
         /// <summary>
+        ///  Selects the solver for the chains that touch no collider: `KDW_SOLVER_LANES` (the default),
+        ///  `KDW_SOLVER_LANES_PORTABLE` or `KDW_SOLVER_SCALAR`. They agree up to float rounding; the choice is part of
+        ///  `kdw_engine_state_hash`. Any other value is rejected with `KDW_STATUS_INVALID_ARGUMENT` and changes nothing.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_engine_set_solver", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_engine_set_solver(kdw_engine* engine, uint solver);
+
+        /// <summary>
+        ///  The engine's solver: one of `KDW_SOLVER_*`.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_engine_get_solver", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern int kdw_engine_get_solver(kdw_engine* engine, uint* out_solver);
+
+        /// <summary>
         ///  Advances every chain by `dt` seconds (scaled by the time scale) in fixed internal steps. `camera_position`
         ///  and `view_reference` (the joint K the view direction is measured from; also the anchor of chains with
         ///  `KDW_ANCHOR_VIEW_REFERENCE`) are in world space. `dt` must be finite and &gt;= 0; `dt == 0` changes
@@ -307,7 +321,7 @@ namespace Kodawari.Native
         internal static extern int kdw_engine_read_local_rotations(kdw_engine* engine, kdw_quat* out_rotations, uint capacity, uint* out_written);
 
         /// <summary>
-        ///  Counters: chains, joints, substeps run, time dropped, chains asleep.
+        ///  Counters: chains, joints, substeps run, time dropped, chains asleep, chains on the lane solver.
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_engine_get_stats", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
         internal static extern int kdw_engine_get_stats(kdw_engine* engine, kdw_engine_stats* out_stats);
@@ -397,6 +411,14 @@ namespace Kodawari.Native
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_version_string", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
         internal static extern byte* kdw_version_string();
+
+        /// <summary>
+        ///  The instruction set `KDW_SOLVER_LANES` runs its kernel with on this CPU: "avx2", "sse2" (the portable
+        ///  x86-64 kernel), "neon" (aarch64) or "scalar" (no SIMD kernel for this architecture).
+        ///  `KDW_SOLVER_LANES_PORTABLE` always runs the portable kernel. Static, NUL-terminated, never NULL.
+        /// </summary>
+        [DllImport(__DllName, EntryPoint = "kdw_simd_path", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]
+        internal static extern byte* kdw_simd_path();
 
         /// <summary>
         ///  Adds a view shape to a chain: when the camera is seen from `direction` (in the view reference joint's
@@ -695,7 +717,16 @@ namespace Kodawari.Native
         ///  Chains that cost nothing in the last step (sleeping or disabled).
         /// </summary>
         public uint chains_asleep;
+        /// <summary>
+        ///  Chains the lane solver stepped in the last `kdw_engine_step`; the others ran on the scalar solver or
+        ///  were asleep or disabled. 0 on `KDW_SOLVER_SCALAR`.
+        /// </summary>
+        public uint lane_chains;
         public uint collider_count;
+        /// <summary>
+        ///  Always 0: keeps the 64-bit fields that follow aligned without hidden padding.
+        /// </summary>
+        public uint reserved;
         public ulong substeps_total;
         /// <summary>
         ///  Internal steps where the direct inextensibility solve failed and a fallback ran.
@@ -834,6 +865,27 @@ namespace Kodawari.Native
         internal const uint KDW_TELEPORT_RESET = 1;
 
         /// <summary>
+        /// The lane solver (the default): chains of equal joint count are stepped side by side, one chain per SIMD
+        /// lane, with the widest kernel copy this CPU has (`kdw_simd_path`). Chains that may touch a collider, and
+        /// the last 1 to 3 chains of a joint count (too few for a group), take the scalar solver in a step. It agrees
+        /// with `KDW_SOLVER_SCALAR` up to float rounding; a chain's bits do not depend on its lane, its group or the
+        /// kernel copy.
+        /// </summary>
+        internal const uint KDW_SOLVER_LANES = 0;
+
+        /// <summary>
+        /// `KDW_SOLVER_LANES` with the portable copy of its kernel (SSE2 on x86-64) whatever the CPU has: the same
+        /// bits, slower. For checking the determinism policy on one machine.
+        /// </summary>
+        internal const uint KDW_SOLVER_LANES_PORTABLE = 1;
+
+        /// <summary>
+        /// One chain at a time: the reference implementation the lane solver is tested against (and what chains near
+        /// colliders always use).
+        /// </summary>
+        internal const uint KDW_SOLVER_SCALAR = 2;
+
+        /// <summary>
         /// The chain's anchor is the view reference joint K given with each step.
         /// </summary>
         internal const uint KDW_ANCHOR_VIEW_REFERENCE = 0;
@@ -870,8 +922,9 @@ namespace Kodawari.Native
         internal const uint KDW_COLLIDER_INSIDE_CAPSULE = 4;
 
         /// <summary>
-        /// Bumped on every incompatible change of the C ABI (signatures, struct layouts, semantics).
+        /// Bumped on every incompatible change of the C ABI (signatures, struct layouts, semantics). 3: solver
+        /// selection, `kdw_engine_stats.lane_chains`.
         /// </summary>
-        internal const uint KDW_ABI_VERSION = 2;
+        internal const uint KDW_ABI_VERSION = 3;
     }
 }

@@ -956,6 +956,13 @@ impl Engine {
             s.iterations as u64,
             s.teleport_mode as u64,
             s.lod as u64,
+            // The solver changes results by float rounding (Lanes and LanesPortable give the same bits, but are
+            // still different settings); a fixed code per solver, independent of the enum's declaration order.
+            match self.solver {
+                Solver::Lanes => 0,
+                Solver::LanesPortable => 1,
+                Solver::Scalar => 2,
+            },
             self.order.len() as u64,
             self.collider_order.len() as u64,
         ];

@@ -5,7 +5,9 @@ use super::guard::{
     with_engine_mut, write,
 };
 use super::status::{KDW_STATUS_OK, kdw_status};
-use super::types::{kdw_chain_id, kdw_engine_def, kdw_engine_stats, kdw_quat, kdw_transform, kdw_vec3};
+use super::types::{
+    kdw_chain_id, kdw_engine_def, kdw_engine_stats, kdw_quat, kdw_transform, kdw_vec3, solver_code, solver_from_code,
+};
 use crate::core::{Engine, EngineSettings, Transform};
 
 /// One per character: owns chains and view shapes, gravity and solver settings. Opaque.
@@ -73,6 +75,29 @@ pub extern "C" fn kdw_engine_set_gravity(engine: *mut kdw_engine, gravity: *cons
         // SAFETY: live engine handle, this thread only.
         unsafe { with_engine_mut(engine, |e| Ok(e.set_gravity((*gravity).into())?)) }
     })
+}
+
+/// Selects the solver for the chains that touch no collider: `KDW_SOLVER_LANES` (the default),
+/// `KDW_SOLVER_LANES_PORTABLE` or `KDW_SOLVER_SCALAR`. They agree up to float rounding; the choice is part of
+/// `kdw_engine_state_hash`. Any other value is rejected with `KDW_STATUS_INVALID_ARGUMENT` and changes nothing.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_set_solver(engine: *mut kdw_engine, solver: u32) -> kdw_status {
+    guard(|| {
+        let solver = solver_from_code(solver)?;
+        // SAFETY: live engine handle, this thread only.
+        unsafe {
+            with_engine_mut(engine, |e| {
+                e.set_solver(solver);
+                Ok(())
+            })
+        }
+    })
+}
+
+/// The engine's solver: one of `KDW_SOLVER_*`.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_engine_get_solver(engine: *const kdw_engine, out_solver: *mut u32) -> kdw_status {
+    query(engine, out_solver, "out_solver", |e| Ok(solver_code(e.solver())))
 }
 
 /// Advances every chain by `dt` seconds (scaled by the time scale) in fixed internal steps. `camera_position`
@@ -220,7 +245,7 @@ pub extern "C" fn kdw_engine_read_local_rotations(
     })
 }
 
-/// Counters: chains, joints, substeps run, time dropped, chains asleep.
+/// Counters: chains, joints, substeps run, time dropped, chains asleep, chains on the lane solver.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_engine_get_stats(engine: *const kdw_engine, out_stats: *mut kdw_engine_stats) -> kdw_status {
     query(engine, out_stats, "out_stats", |e| Ok(e.stats().into()))

@@ -4,7 +4,7 @@
 use glam::{Quat, Vec3};
 
 use crate::core::{
-    AnchorSource, ChainParams, ColliderDef, ColliderShape, EngineSettings, Stats, TeleportMode, Transform,
+    AnchorSource, ChainParams, ColliderDef, ColliderShape, EngineSettings, Solver, Stats, TeleportMode, Transform,
 };
 
 /// A 3D vector, the layout of Unity's `Vector3`.
@@ -48,6 +48,19 @@ pub type kdw_collider_id = u64;
 pub const KDW_TELEPORT_CARRY_SHAPE: u32 = 0;
 /// A teleport puts the chain back to its rest shape under the new anchor, at rest.
 pub const KDW_TELEPORT_RESET: u32 = 1;
+
+/// The lane solver (the default): chains of equal joint count are stepped side by side, one chain per SIMD
+/// lane, with the widest kernel copy this CPU has (`kdw_simd_path`). Chains that may touch a collider, and
+/// the last 1 to 3 chains of a joint count (too few for a group), take the scalar solver in a step. It agrees
+/// with `KDW_SOLVER_SCALAR` up to float rounding; a chain's bits do not depend on its lane, its group or the
+/// kernel copy.
+pub const KDW_SOLVER_LANES: u32 = 0;
+/// `KDW_SOLVER_LANES` with the portable copy of its kernel (SSE2 on x86-64) whatever the CPU has: the same
+/// bits, slower. For checking the determinism policy on one machine.
+pub const KDW_SOLVER_LANES_PORTABLE: u32 = 1;
+/// One chain at a time: the reference implementation the lane solver is tested against (and what chains near
+/// colliders always use).
+pub const KDW_SOLVER_SCALAR: u32 = 2;
 
 /// The chain's anchor is the view reference joint K given with each step.
 pub const KDW_ANCHOR_VIEW_REFERENCE: u32 = 0;
@@ -136,7 +149,12 @@ pub struct kdw_engine_stats {
     pub substeps_last_step: u32,
     /// Chains that cost nothing in the last step (sleeping or disabled).
     pub chains_asleep: u32,
+    /// Chains the lane solver stepped in the last `kdw_engine_step`; the others ran on the scalar solver or
+    /// were asleep or disabled. 0 on `KDW_SOLVER_SCALAR`.
+    pub lane_chains: u32,
     pub collider_count: u32,
+    /// Always 0: keeps the 64-bit fields that follow aligned without hidden padding.
+    pub reserved: u32,
     pub substeps_total: u64,
     /// Internal steps where the direct inextensibility solve failed and a fallback ran.
     pub solver_fallbacks: u64,
@@ -348,6 +366,28 @@ impl TryFrom<&kdw_chain_def> for ChainParams {
     }
 }
 
+/// The `KDW_SOLVER_*` value of a solver.
+pub(crate) fn solver_code(solver: Solver) -> u32 {
+    match solver {
+        Solver::Lanes => KDW_SOLVER_LANES,
+        Solver::LanesPortable => KDW_SOLVER_LANES_PORTABLE,
+        Solver::Scalar => KDW_SOLVER_SCALAR,
+    }
+}
+
+/// The solver a `KDW_SOLVER_*` value names; any other value is an invalid argument.
+pub(crate) fn solver_from_code(code: u32) -> crate::core::Result<Solver> {
+    match code {
+        KDW_SOLVER_LANES => Ok(Solver::Lanes),
+        KDW_SOLVER_LANES_PORTABLE => Ok(Solver::LanesPortable),
+        KDW_SOLVER_SCALAR => Ok(Solver::Scalar),
+        other => Err(crate::core::Error::invalid_argument(format!(
+            "unknown solver {other}: expected KDW_SOLVER_LANES (0), KDW_SOLVER_LANES_PORTABLE (1) or \
+             KDW_SOLVER_SCALAR (2)"
+        ))),
+    }
+}
+
 impl From<Stats> for kdw_engine_stats {
     fn from(s: Stats) -> Self {
         Self {
@@ -356,7 +396,9 @@ impl From<Stats> for kdw_engine_stats {
             joint_count: s.joint_count,
             substeps_last_step: s.substeps_last_step,
             chains_asleep: s.chains_asleep,
+            lane_chains: s.lane_chains,
             collider_count: s.collider_count,
+            reserved: 0,
             substeps_total: s.substeps_total,
             solver_fallbacks: s.solver_fallbacks,
             time_dropped: s.time_dropped,
@@ -378,7 +420,7 @@ mod tests {
         assert_eq!(size_of::<kdw_transform>(), 28);
         assert_eq!(size_of::<kdw_engine_def>(), 4 + 12 + 10 * 4);
         assert_eq!(size_of::<kdw_chain_def>(), 10 * 4);
-        assert_eq!(size_of::<kdw_engine_stats>(), 6 * 4 + 5 * 8);
+        assert_eq!(size_of::<kdw_engine_stats>(), 8 * 4 + 5 * 8);
         assert_eq!(size_of::<kdw_collider_def>(), 4 * 4 + 28 + 4);
     }
 }

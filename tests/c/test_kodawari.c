@@ -26,7 +26,7 @@ _Static_assert(sizeof(kdw_quat) == 16, "kdw_quat is 16 bytes");
 _Static_assert(sizeof(kdw_transform) == 28, "kdw_transform is 28 bytes");
 _Static_assert(sizeof(kdw_engine_def) == 56, "kdw_engine_def is 56 bytes");
 _Static_assert(sizeof(kdw_chain_def) == 40, "kdw_chain_def is 40 bytes");
-_Static_assert(sizeof(kdw_engine_stats) == 64, "kdw_engine_stats is 64 bytes");
+_Static_assert(sizeof(kdw_engine_stats) == 72, "kdw_engine_stats is 72 bytes");
 _Static_assert(sizeof(kdw_collider_def) == 48, "kdw_collider_def is 48 bytes");
 _Static_assert(sizeof(kdw_status) == 4, "kdw_status is int32_t");
 _Static_assert(sizeof(kdw_chain_id) == 8, "kdw_chain_id is uint64_t");
@@ -77,19 +77,22 @@ _Static_assert(offsetof(kdw_engine_stats, chain_count) == 4, "kdw_engine_stats l
 _Static_assert(offsetof(kdw_engine_stats, joint_count) == 8, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, substeps_last_step) == 12, "kdw_engine_stats layout");
 _Static_assert(offsetof(kdw_engine_stats, chains_asleep) == 16, "kdw_engine_stats layout");
-_Static_assert(offsetof(kdw_engine_stats, collider_count) == 20, "kdw_engine_stats layout");
-_Static_assert(offsetof(kdw_engine_stats, substeps_total) == 24, "kdw_engine_stats layout");
-_Static_assert(offsetof(kdw_engine_stats, solver_fallbacks) == 32, "kdw_engine_stats layout");
-_Static_assert(offsetof(kdw_engine_stats, time_dropped) == 40, "kdw_engine_stats layout");
-_Static_assert(offsetof(kdw_engine_stats, simulated_time) == 48, "kdw_engine_stats layout");
-_Static_assert(offsetof(kdw_engine_stats, contact_pairs_tested) == 56, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, lane_chains) == 20, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, collider_count) == 24, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, reserved) == 28, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, substeps_total) == 32, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, solver_fallbacks) == 40, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, time_dropped) == 48, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, simulated_time) == 56, "kdw_engine_stats layout");
+_Static_assert(offsetof(kdw_engine_stats, contact_pairs_tested) == 64, "kdw_engine_stats layout");
 
 /* The constants the bindings mirror. */
-_Static_assert(KDW_ABI_VERSION == 2, "colliders, teleport modes and scale are ABI version 2");
+_Static_assert(KDW_ABI_VERSION == 3, "solver selection and kdw_engine_stats.lane_chains are ABI version 3");
 _Static_assert(KDW_COLLIDER_SPHERE == 0 && KDW_COLLIDER_CAPSULE == 1 && KDW_COLLIDER_PLANE == 2 &&
                    KDW_COLLIDER_INSIDE_SPHERE == 3 && KDW_COLLIDER_INSIDE_CAPSULE == 4,
                "collider shapes");
 _Static_assert(KDW_TELEPORT_CARRY_SHAPE == 0 && KDW_TELEPORT_RESET == 1, "teleport modes");
+_Static_assert(KDW_SOLVER_LANES == 0 && KDW_SOLVER_LANES_PORTABLE == 1 && KDW_SOLVER_SCALAR == 2, "solvers");
 
 /* ---- constants ------------------------------------------------------------------------------------------ */
 
@@ -536,6 +539,7 @@ static int test_layout(void)
     ENSURE(stats.collider_count == 0 && stats.contact_pairs_tested == 0);
     ENSURE(stats.chain_count == 0 && stats.joint_count == 0 && stats.substeps_total == 0);
     ENSURE(stats.simulated_time == 0.0 && stats.time_dropped == 0.0);
+    ENSURE(stats.lane_chains == 0 && stats.reserved == 0);
     ENSURE_OK(engine_free(engine));
     return 0;
 }
@@ -698,6 +702,7 @@ static int test_life_cycle(void)
     ENSURE(stats.chains_asleep <= stats.chain_count);
     ENSURE(stats.collider_count == 0 && stats.contact_pairs_tested == 0); /* no colliders, no contact cost */
     ENSURE(stats.solver_fallbacks == 0);
+    ENSURE(stats.lane_chains == 0); /* three different joint counts: no lane group, all on the scalar solver */
     ENSURE(stats.time_dropped == 0.0);
     ENSURE_SMALL(stats.simulated_time - ORBIT_FRAMES * (double)FRAME_DT, 1e-9);
 
@@ -1047,6 +1052,126 @@ static int determinism_case(int with_view_shapes)
 
 static int test_determinism_without_view_shapes(void) { return determinism_case(0); }
 static int test_determinism_with_view_shapes(void) { return determinism_case(1); }
+
+/* ---- solver selection ------------------------------------------------------------------------------------- */
+
+#define SOLVER_CHAINS 4
+#define SOLVER_JOINTS 8
+#define SOLVER_TOTAL (SOLVER_CHAINS * SOLVER_JOINTS)
+#define SOLVER_FRAMES 120
+/* Scalar vs lane solver after SOLVER_FRAMES frames, m: they implement the same operations grouped
+ * differently, so they differ by float rounding only (measured 3.0e-8 m on these 0.28 m chains). */
+#define SOLVER_AGREEMENT_TOL 1e-6
+
+/* Four chains of 8 joints hanging from the head side by side (different stiffness) on a fresh engine, no
+ * colliders: one lane group of 4 on the lane solvers. Hanging, so that their motion is not chaotic and the
+ * solvers' rounding differences stay rounding-sized. */
+static kdw_vec3 solver_root(int chain) { return v3(-0.06f + 0.04f * (float)chain, 0.0f, 0.08f); }
+
+static int solver_scene(kdw_engine **out, uint32_t solver)
+{
+    kdw_engine *engine = engine_new_default();
+    ENSURE(engine != NULL);
+    uint32_t got = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_get_solver(engine, &got));
+    ENSURE(got == KDW_SOLVER_LANES); /* the default */
+    ENSURE_OK(kdw_engine_set_solver(engine, solver));
+    got = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_get_solver(engine, &got));
+    ENSURE(got == solver);
+    for (int c = 0; c < SOLVER_CHAINS; ++c) {
+        chain_spec spec;
+        make_straight(&spec, SOLVER_JOINTS, solver_root(c), v3(0.0f, -1.0f, 0.0f), 0.04f);
+        kdw_chain_def def = kdw_chain_def_default();
+        def.stiffness = 0.3f + 0.2f * (float)c;
+        kdw_chain_id id = 0;
+        ENSURE_OK(kdw_chain_create(engine, &def, spec.joints, spec.n, &id));
+    }
+    *out = engine;
+    return 0;
+}
+
+/* kdw_engine_set_solver / kdw_engine_get_solver round trips, kdw_engine_stats.lane_chains counts the chains the
+ * lane solver stepped (all four on both lane solvers, none on the scalar one), the two lane solvers give the
+ * same bits (the kernel copy does not change a chain's result), the scalar solver agrees up to rounding, and the
+ * solver is part of the state hash. kdw_simd_path names the kernel. */
+static int test_solver_selection(void)
+{
+    const char *path = kdw_simd_path();
+    ENSURE(path != NULL);
+    ENSURE(strcmp(path, "avx2") == 0 || strcmp(path, "sse2") == 0 || strcmp(path, "neon") == 0 ||
+           strcmp(path, "scalar") == 0);
+    ENSURE(kdw_simd_path() == path); /* static */
+
+    const uint32_t solvers[3] = {KDW_SOLVER_LANES, KDW_SOLVER_LANES_PORTABLE, KDW_SOLVER_SCALAR};
+    const uint32_t expected_lane_chains[3] = {SOLVER_CHAINS, SOLVER_CHAINS, 0};
+    kdw_engine *engines[3];
+    uint64_t hashes[3];
+    for (int i = 0; i < 3; ++i) {
+        ENSURE(solver_scene(&engines[i], solvers[i]) == 0);
+        hashes[i] = hash_of(engines[i]);
+    }
+    /* Before any step the engines differ only in their solver: so do their hashes. */
+    ENSURE(hashes[0] != hashes[1] && hashes[0] != hashes[2] && hashes[1] != hashes[2]);
+    ENSURE_OK(kdw_engine_set_solver(engines[1], KDW_SOLVER_LANES));
+    ENSURE(hash_of(engines[1]) == hashes[0]);
+    ENSURE_OK(kdw_engine_set_solver(engines[1], KDW_SOLVER_LANES_PORTABLE));
+    ENSURE(hash_of(engines[1]) == hashes[1]);
+
+    /* An unknown solver is rejected and changes nothing. */
+    ENSURE_REJECTED(engines[2], kdw_engine_set_solver(engines[2], 3), KDW_STATUS_INVALID_ARGUMENT);
+    ENSURE(strstr(harness_last_error(), "solver") != NULL);
+    ENSURE_REJECTED(engines[2], kdw_engine_set_solver(engines[2], UINT32_MAX), KDW_STATUS_INVALID_ARGUMENT);
+    uint32_t got = SENTINEL_U32;
+    ENSURE_OK(kdw_engine_get_solver(engines[2], &got));
+    ENSURE(got == KDW_SOLVER_SCALAR);
+
+    /* The head sways gently sideways (2 cm at 0.5 Hz), so the chains swing and never fall asleep. */
+    kdw_transform head = head_at_rest();
+    for (int frame = 0; frame < SOLVER_FRAMES; ++frame) {
+        head.position.x = 0.02f * sinf(0.05f * (float)frame);
+        for (int i = 0; i < 3; ++i) {
+            ENSURE(step_orbit(engines[i], frame, &head) == 0);
+            kdw_engine_stats stats;
+            ENSURE_OK(kdw_engine_get_stats(engines[i], &stats));
+            ENSURE(stats.chain_count == SOLVER_CHAINS && stats.chains_asleep == 0);
+            ENSURE(stats.lane_chains == expected_lane_chains[i]);
+        }
+    }
+
+    kdw_transform world[3][SOLVER_TOTAL];
+    kdw_quat local[3][SOLVER_TOTAL];
+    for (int i = 0; i < 3; ++i) {
+        uint32_t written = 0;
+        ENSURE_OK(kdw_engine_read_world(engines[i], world[i], SOLVER_TOTAL, &written));
+        ENSURE(written == SOLVER_TOTAL);
+        ENSURE_OK(kdw_engine_read_local_rotations(engines[i], local[i], SOLVER_TOTAL, &written));
+        ENSURE(written == SOLVER_TOTAL);
+    }
+    /* Lanes and portable lanes: bit for bit. */
+    ENSURE(memcmp(world[0], world[1], sizeof world[0]) == 0);
+    ENSURE(memcmp(local[0], local[1], sizeof local[0]) == 0);
+    /* Lanes and scalar: float rounding; and the chains did bend away from their rest shape under the head. */
+    double largest = 0.0, moved = 0.0;
+    for (int j = 0; j < SOLVER_TOTAL; ++j) {
+        ENSURE(v_is_finite(world[0][j].position) && v_is_finite(world[2][j].position));
+        double d = v_dist(world[0][j].position, world[2][j].position);
+        largest = d > largest ? d : largest;
+    }
+    for (int c = 0; c < SOLVER_CHAINS; ++c) {
+        const kdw_transform tip = world[0][c * SOLVER_JOINTS + SOLVER_JOINTS - 1];
+        const kdw_vec3 hanging = v3(0.0f, -0.04f * (float)(SOLVER_JOINTS - 1), 0.0f);
+        const kdw_vec3 rest_tip = v_add(head.position, v_add(solver_root(c), hanging));
+        double d = v_dist(tip.position, rest_tip);
+        moved = d > moved ? d : moved;
+    }
+    printf("     simd path %s; lanes vs scalar after %d frames: largest joint difference %.3g m (tips swung up to "
+           "%.3g m off rest)\n",
+           path, SOLVER_FRAMES, largest, moved);
+    ENSURE(moved > 1e-3);
+    ENSURE(largest <= SOLVER_AGREEMENT_TOL);
+    return 0;
+}
 
 /* Edge cases of the anchor and camera: a camera sitting on the view reference (no view direction), a teleport
  * (far jump and half turn in one step), and a new base shape whose segment lengths the chain takes on. */
@@ -2056,6 +2181,8 @@ static int test_error_null_engine(void)
     ENSURE_REJECTED(w, kdw_engine_get_def(NULL, &engine_def_out), NP);
     ENSURE_REJECTED(w, kdw_engine_set_def(NULL, &engine_def), NP);
     ENSURE_REJECTED(w, kdw_engine_set_gravity(NULL, &gravity), NP);
+    ENSURE_REJECTED(w, kdw_engine_set_solver(NULL, KDW_SOLVER_SCALAR), NP);
+    ENSURE_REJECTED(w, kdw_engine_get_solver(NULL, &u), NP);
     ENSURE_REJECTED(w, kdw_engine_step(NULL, FRAME_DT, &camera, &head), NP);
     ENSURE_REJECTED(w, kdw_engine_set_anchors(NULL, anchors, 3), NP);
     ENSURE_REJECTED(w, kdw_engine_chain_count(NULL, &u), NP);
@@ -2124,6 +2251,7 @@ static int test_error_null_out_pointers(void)
     ENSURE_REJECTED(e, kdw_engine_read_local_rotations(e, NULL, MAX_TOTAL, &u), NP);
     ENSURE_REJECTED(e, kdw_engine_read_local_rotations(e, quats, MAX_TOTAL, NULL), NP);
     ENSURE_REJECTED(e, kdw_engine_get_stats(e, NULL), NP);
+    ENSURE_REJECTED(e, kdw_engine_get_solver(e, NULL), NP);
     ENSURE_REJECTED(e, kdw_engine_state_hash(e, NULL), NP);
     ENSURE_REJECTED(e, kdw_chain_add_view_shape(e, chain, &direction, g_ahoge.joints, g_ahoge.n, 1.0f, NULL), NP);
     ENSURE_REJECTED(e, kdw_chain_view_shape_count(e, chain, NULL), NP);
@@ -2658,6 +2786,7 @@ int main(void)
     RUN_TEST(test_substep_clock);
     RUN_TEST(test_determinism_without_view_shapes);
     RUN_TEST(test_determinism_with_view_shapes);
+    RUN_TEST(test_solver_selection);
     RUN_TEST(test_teleport_camera_on_head_and_new_base);
     RUN_TEST(test_dt_zero_changes_nothing);
     RUN_TEST(test_non_unit_view_reference);

@@ -8,6 +8,7 @@ void discard_everything(kodawari::Engine& engine, kodawari::ViewDependentPhysica
     engine.colliderCount();                  // DISCARD
     collider.isValid();                      // DISCARD
     engine.stateHash();                      // DISCARD
+    engine.solver();                         // DISCARD
     chain.jointCount();                      // DISCARD
     chain.isValid();                         // DISCARD
     chain.isEnabled();                       // DISCARD
@@ -19,6 +20,7 @@ void discard_everything(kodawari::Engine& engine, kodawari::ViewDependentPhysica
     chain.destroy();                         // DISCARD
     shape.remove();                          // DISCARD
     engine.teleport();                       // DISCARD
+    engine.setSolver(kodawari::Solver::Scalar);  // DISCARD
     engine.setColliderTransforms(nullptr, 0);  // DISCARD
     chain.teleport();                        // DISCARD
     collider.destroy();                      // DISCARD

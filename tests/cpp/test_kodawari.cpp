@@ -67,6 +67,9 @@ using kodawari::ViewShape;
 static_assert(std::is_same_v<decltype(std::declval<Engine&>().chainCount()), uint32_t>);
 static_assert(std::is_same_v<decltype(std::declval<Engine&>().step(0.0f, {}, {})), void>);
 static_assert(std::is_same_v<kodawari::Ret<ViewShape>, ViewShape>);
+static_assert(std::is_same_v<decltype(std::declval<Engine&>().solver()), kodawari::Solver>);
+static_assert(std::is_same_v<decltype(std::declval<Engine&>().setSolver(kodawari::Solver::Scalar)), void>);
+static_assert(std::is_same_v<std::underlying_type_t<kodawari::Solver>, uint32_t>);
 
 // Ownership: move-only engine, cheap copyable handles.
 static_assert(!std::is_copy_constructible_v<Engine> && !std::is_copy_assignable_v<Engine>);
@@ -104,6 +107,8 @@ void test_defaults_and_versions() {
     CHECK(chain_def.collision_mask == 0xFFFFFFFFu && chain_def.friction == 0.3f);
     CHECK(kodawari::abiVersion() == KDW_ABI_VERSION);
     CHECK(std::string(kodawari::versionString()).size() > 0);
+    const std::string simd = kodawari::simdPath();
+    CHECK(simd == "avx2" || simd == "sse2" || simd == "neon" || simd == "scalar");
     CHECK(std::string(kodawari::statusString(KDW_STATUS_INVALID_ID)) == kdw_status_str(KDW_STATUS_INVALID_ID));
 }
 
@@ -892,6 +897,47 @@ void test_collider_set_size() {
     hood.setSize(0.6f, 0.0f);
 }
 
+// Engine::setSolver / solver() round trip; four equal chains without colliders make one lane group (stats
+// lane_chains 4) on the lane solvers and none on the scalar one; both lane solvers give the same bits; an
+// unknown value throws and changes nothing.
+void test_solver_selection() {
+    const harness::Scene scene = harness::ahoge_scene();
+    const kodawari::Solver solvers[3] = {kodawari::Solver::Lanes, kodawari::Solver::LanesPortable,
+                                         kodawari::Solver::Scalar};
+    std::vector<Engine> engines;
+    for (const kodawari::Solver solver : solvers) {
+        engines.emplace_back(EngineDef());
+        Engine& engine = engines.back();
+        CHECK(engine.solver() == kodawari::Solver::Lanes);  // the default
+        engine.setSolver(solver);
+        CHECK(engine.solver() == solver);
+        for (int c = 0; c < 4; ++c) {
+            ChainDef def = ahoge_def(scene);
+            def.stiffness = 0.3f + 0.2f * static_cast<float>(c);
+            engine.createChain(def, scene.base);
+        }
+    }
+    CHECK(engines[0].stateHash() != engines[1].stateHash() && engines[0].stateHash() != engines[2].stateHash());
+
+    const uint64_t before = engines[0].stateHash();
+    CHECK_THROWS(engines[0].setSolver(static_cast<kodawari::Solver>(3)), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK(engines[0].stateHash() == before && engines[0].solver() == kodawari::Solver::Lanes);
+
+    Transform head = scene.head;  // sways gently, so the chains keep moving (a still chain would fall asleep)
+    for (int frame = 0; frame < 60; ++frame) {
+        head.position.x = 0.02f * std::sin(0.05f * static_cast<float>(frame));
+        for (Engine& engine : engines) engine.step(harness::kDt, harness::orbit_camera(frame), head);
+    }
+    CHECK(engines[0].stats().lane_chains == 4 && engines[1].stats().lane_chains == 4);
+    CHECK(engines[2].stats().lane_chains == 0 && engines[2].stats().chain_count == 4);
+    std::vector<Transform> lanes, portable, scalar;
+    engines[0].readWorld(lanes);
+    engines[1].readWorld(portable);
+    engines[2].readWorld(scalar);
+    CHECK(harness::same_bits(lanes, portable));
+    CHECK(scalar.size() == lanes.size());
+}
+
 // Runs a test; an unexpected exception fails it.
 #define RUN(test)                                                                          \
     harness::run(#test, [] {                                                               \
@@ -919,6 +965,7 @@ int main() {
     RUN(test_settled_chain_sleeps);
     RUN(test_step_engines_equals_single_steps);
     RUN(test_collider_set_size);
+    RUN(test_solver_selection);
     run_no_exception_tests();
     std::printf("%d passed, %d failed\n", harness::counters().passed, harness::counters().failed);
     return harness::counters().failed == 0 ? 0 : 1;

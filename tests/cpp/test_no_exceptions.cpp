@@ -36,6 +36,8 @@ static_assert(std::is_same_v<decltype(std::declval<Engine&>().createCollider(kod
                              Result<kodawari::Collider>>);
 static_assert(std::is_same_v<decltype(std::declval<Engine&>().setColliderTransforms(nullptr, 0)), Status>);
 static_assert(std::is_same_v<decltype(std::declval<Engine&>().teleport()), Status>);
+static_assert(std::is_same_v<decltype(std::declval<Engine&>().setSolver(kodawari::Solver::Scalar)), Status>);
+static_assert(std::is_same_v<decltype(std::declval<Engine&>().solver()), Result<kodawari::Solver>>);
 static_assert(std::is_same_v<kodawari::Ret<void>, Status>);
 static_assert(!std::is_constructible_v<Engine, const EngineDef&>, "no throwing constructor without exceptions");
 
@@ -115,6 +117,13 @@ void test_no_exceptions_scene() {
     CHECK(ball.value().destroy().ok());
     CHECK_FAILS(ball.value().setLayers(2u), KDW_STATUS_INVALID_ID);
     CHECK(engine.colliderCount().valueOr(9) == 0);
+
+    // Solver selection.
+    CHECK(engine.solver().value() == kodawari::Solver::Lanes);
+    CHECK(engine.setSolver(kodawari::Solver::Scalar).ok() && engine.solver().value() == kodawari::Solver::Scalar);
+    CHECK_FAILS(engine.setSolver(static_cast<kodawari::Solver>(7)), KDW_STATUS_INVALID_ARGUMENT);
+    CHECK(engine.solver().value() == kodawari::Solver::Scalar);
+    CHECK_FAILS(Engine().solver(), KDW_STATUS_NULL_POINTER);
 }
 
 // Culling, sleeping state, collider resizing and batch stepping return results too.

@@ -13,7 +13,7 @@ static unsafe class Tests
 
     static int Main()
     {
-        Console.WriteLine("kodawari " + Library.Version + ", ABI " + Library.AbiVersion + ", runtime "
+        Console.WriteLine("kodawari " + Library.Version + ", ABI " + Library.AbiVersion + ", SIMD " + Library.SimdPath + ", runtime "
                           + (Type.GetType("Mono.Runtime") != null ? "Mono" : ".NET"));
         Run("abi_and_struct_sizes", AbiAndStructSizes);
         Run("life_cycle", LifeCycle);
@@ -38,6 +38,8 @@ static unsafe class Tests
         Run("step_many_equals_single_steps", CullingTests.StepManyEqualsSingleSteps);
         Run("collider_set_size_pushes_the_chain_out", CullingTests.ColliderSetSizePushesTheChainOut);
         Run("batch_and_culling_allocate_nothing", CullingTests.BatchAndCullingAllocateNothing);
+        Run("solver_selection", SolverTests.SolverSelection);
+        Run("solver_calls_allocate_nothing", SolverTests.SolverCallsAllocateNothing);
         Run("readme_snippet", ReadmeSnippet.Run);
         Console.WriteLine(passed + " passed, " + failed + " failed");
         return failed;
@@ -121,7 +123,7 @@ static unsafe class Tests
         Ensure(sizeof(kdw_transform) == 28 && System.Runtime.InteropServices.Marshal.SizeOf(typeof(kdw_transform)) == 28,
                "kdw_transform is 28 bytes");
         Ensure(sizeof(JointTransform) == 28 && sizeof(Vec3) == 12 && sizeof(Quat) == 16, "public structs match");
-        Ensure(sizeof(kdw_engine_def) == 56 && sizeof(kdw_chain_def) == 40 && sizeof(kdw_engine_stats) == 64
+        Ensure(sizeof(kdw_engine_def) == 56 && sizeof(kdw_chain_def) == 40 && sizeof(kdw_engine_stats) == 72
                && sizeof(kdw_collider_def) == 48, "def struct sizes match the C header");
         var mismatch = ExpectStatus(KodawariStatus.AbiMismatch, () => Library.CheckAbi(NativeMethods.KDW_ABI_VERSION + 1, NativeMethods.KDW_ABI_VERSION));
         Ensure(mismatch.Message.Contains("ABI"), "ABI mismatch message: " + mismatch.Message);

@@ -97,6 +97,21 @@ namespace Kodawari
             set { Library.Check(NativeMethods.kdw_engine_set_gravity(Ptr, (kdw_vec3*)&value)); }
         }
 
+        /// <summary>The solver for the chains that touch no collider (<see cref="Kodawari.Solver.Lanes"/> by default):
+        /// the solvers agree up to float rounding, and the choice is part of <see cref="StateHash"/>. Setting a value
+        /// outside <see cref="Kodawari.Solver"/> throws (<see cref="KodawariStatus.InvalidArgument"/>) and changes
+        /// nothing. Allocation-free.</summary>
+        public Solver Solver
+        {
+            get
+            {
+                uint solver = 0;
+                Library.Check(NativeMethods.kdw_engine_get_solver(Ptr, &solver));
+                return (Solver)solver;
+            }
+            set { Library.Check(NativeMethods.kdw_engine_set_solver(Ptr, (uint)value)); }
+        }
+
         /// <summary>The level of detail (<see cref="EngineDef.Lod"/>, 0 to 3), read and written through the engine's
         /// settings without allocating: e.g. set per character by its distance to the camera. Setting it wakes every
         /// chain; set it only when it changes.</summary>
@@ -368,7 +383,7 @@ namespace Kodawari
             }
         }
 
-        /// <summary>Counters: chains, joints, substeps run, time dropped, chains asleep.</summary>
+        /// <summary>Counters: chains, joints, substeps run, time dropped, chains asleep, chains on the lane solver.</summary>
         public EngineStats Stats
         {
             get
@@ -382,6 +397,7 @@ namespace Kodawari
                     JointCount = (int)raw.joint_count,
                     SubstepsLastStep = (int)raw.substeps_last_step,
                     ChainsAsleep = (int)raw.chains_asleep,
+                    LaneChains = (int)raw.lane_chains,
                     SubstepsTotal = (long)raw.substeps_total,
                     SolverFallbacks = (long)raw.solver_fallbacks,
                     TimeDropped = raw.time_dropped,

@@ -23,6 +23,19 @@ namespace Kodawari
         /// <summary>The loaded native library's version, e.g. "0.1.0".</summary>
         public static string Version { get { return Utf8(NativeMethods.kdw_version_string()); } }
 
+        static string simdPath;
+
+        /// <summary>The instruction set the lane solver's kernel runs with on this CPU: "avx2", "sse2" (the portable
+        /// x86-64 kernel), "neon" or "scalar". Read once, then cached.</summary>
+        public static string SimdPath
+        {
+            get
+            {
+                if (simdPath == null) simdPath = Utf8(NativeMethods.kdw_simd_path());
+                return simdPath;
+            }
+        }
+
         /// <summary>Throws when the loaded library does not match these bindings: a different ABI version, or
         /// struct layouts that differ from the C ABI's (28-byte transforms). Cheap after the first success;
         /// <see cref="Engine"/> calls it before creating anything.</summary>

@@ -113,6 +113,20 @@ namespace Kodawari
         Reset = NativeMethods.KDW_TELEPORT_RESET,
     }
 
+    /// <summary>Which solver steps an engine's chains that touch no collider (<c>KDW_SOLVER_*</c>, <see cref="Engine.Solver"/>).
+    /// They agree up to float rounding; a chain's bits never depend on its lane, its group or the kernel copy.</summary>
+    public enum Solver : uint
+    {
+        /// <summary>Chains of equal joint count side by side in SIMD lanes (the default). Chains near colliders and the
+        /// last 1 to 3 chains of a joint count (too few for a group) take the scalar solver.</summary>
+        Lanes = NativeMethods.KDW_SOLVER_LANES,
+        /// <summary><see cref="Lanes"/> with the portable kernel copy whatever the CPU has: the same bits, slower (for
+        /// determinism checks).</summary>
+        LanesPortable = NativeMethods.KDW_SOLVER_LANES_PORTABLE,
+        /// <summary>One chain at a time: the reference implementation.</summary>
+        Scalar = NativeMethods.KDW_SOLVER_SCALAR,
+    }
+
     /// <summary>The shape of a <see cref="Collider"/> (<c>KDW_COLLIDER_*</c>).</summary>
     public enum ColliderShape : uint
     {
@@ -137,6 +151,9 @@ namespace Kodawari
         public int SubstepsLastStep;
         /// <summary>Chains that cost nothing in the last step (sleeping or disabled).</summary>
         public int ChainsAsleep;
+        /// <summary>Chains the lane solver stepped in the last step; the others ran on the scalar solver or were asleep
+        /// or disabled. 0 on <see cref="Solver.Scalar"/>.</summary>
+        public int LaneChains;
         public long SubstepsTotal;
         /// <summary>Internal steps where the direct inextensibility solve failed and a fallback ran.</summary>
         public long SolverFallbacks;

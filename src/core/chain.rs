@@ -8,7 +8,7 @@ use super::blend::blend_into;
 use super::error::{Error, Result};
 use super::math::{Transform, direction, nlerp_shorter, swing_to};
 use super::params::{ChainParams, EngineSettings, SLEEP_DELAY};
-use super::rod::{RestGroups, RodState};
+use super::rod::{CONTACT_SETTLED, RestGroups, RodState};
 use super::shape::{EncodedShape, Shape, ShapeFrame};
 use super::weights::{ViewWeighting, blend_weights};
 
@@ -137,6 +137,17 @@ impl Chain {
     }
 
     /// Collision radius of each joint in metres under `scale`, into `out`.
+    /// How deep (m) a joint must have been inside a collider at the start of a substep to count as overlapping
+    /// since then (`ContactInput::slop`): a share of the chain's shortest segment.
+    pub(crate) fn contact_slop(&self) -> f32 {
+        CONTACT_SLOP * self.frame.lengths.iter().copied().fold(f32::INFINITY, f32::min)
+    }
+
+    /// A contact pass whose corrections stay below this (m) has settled (`rod::substep`'s final rounds).
+    pub(crate) fn contact_settled(&self) -> f32 {
+        CONTACT_SETTLED * self.shortest_segment
+    }
+
     pub(crate) fn scaled_radii(&self, scale: f32, out: &mut Vec<f32>) {
         out.clear();
         if self.joint_radii.is_empty() {
@@ -336,6 +347,10 @@ impl Chain {
         self.views.iter().position(|v| v.id == id)
     }
 }
+
+/// Share of a chain's shortest segment a joint must have been inside a collider at the start of a substep to
+/// count as overlapping since then (see [`ContactInput::slop`](super::collision::ContactInput::slop)).
+const CONTACT_SLOP: f32 = 1e-3;
 
 fn shortest(lengths: &[f32]) -> f32 {
     lengths.iter().copied().fold(f32::INFINITY, f32::min)

@@ -11,7 +11,7 @@ use super::chain::{Chain, ViewShape, ViewShapeId, relative_rotation};
 use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderSweep};
 use super::collision::ContactInput;
 use super::error::{Error, Result};
-use super::lanes::{Clock, LaneJob, LaneSolver, Solver};
+use super::lanes::{Clock, LaneJob, LaneSolver, Solver, StepContacts};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
 use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, TeleportMode};
 use super::rod::{ChainConstants, RodScratch, SubstepInput, carry_to_new_rest, substep};
@@ -66,7 +66,7 @@ impl ScalarRun<'_> {
         scratch: &mut RodScratch,
     ) -> (u64, u64) {
         let (h, collider_count) = (self.h, self.collider_count);
-        let slop = CONTACT_SLOP * chain.frame.lengths.iter().copied().fold(f32::INFINITY, f32::min);
+        let slop = chain.contact_slop();
         let substeps = self.progress.len();
         let (mut fallbacks, mut contact_pairs) = (0, 0);
         for (s, &progress) in self.progress.iter().enumerate() {
@@ -84,7 +84,7 @@ impl ScalarRun<'_> {
                 iterations: self.iterations,
                 rest: &chain.rest,
                 rest_groups: &chain.rest_groups,
-                shortest_segment: chain.shortest_segment,
+                contact_settled: chain.contact_settled(),
                 half_kick: chain.half_kick,
                 contacts: contacts.as_deref().filter(|_| touching).map(|contacts| ContactInput {
                     colliders: &contacts.chain_sweeps,
@@ -104,10 +104,6 @@ impl ScalarRun<'_> {
         (fallbacks, contact_pairs)
     }
 }
-
-/// Share of a chain's shortest segment a joint must have been inside a collider at the start of a substep to
-/// count as overlapping since then (see [`ContactInput::slop`]).
-const CONTACT_SLOP: f32 = 1e-3;
 
 /// Salts ids so that an id from one engine is rejected by another. Only distinguishes engines; it never
 /// influences simulation results, so it is the one piece of process-wide state the library keeps.
@@ -147,6 +143,8 @@ struct ContactScratch {
     sweeps: Vec<ColliderSweep>,
     /// Indices (in collider order) of the colliders the current chain can touch this step.
     candidates: Vec<usize>,
+    /// The candidates of every lane job of the step, one after the other (`LaneJob::candidates`).
+    lane_candidates: Vec<usize>,
     /// Their sweeps in the current substep.
     chain_sweeps: Vec<ColliderSweep>,
     radii: Vec<f32>,
@@ -615,6 +613,7 @@ impl Engine {
         };
 
         self.progress.clear();
+        self.contact_scratch.lane_candidates.clear();
         self.progress.extend((0..substeps).map(progress));
         let progress_at_start = |s: u64| if s == 0 { 0.0 } else { progress(s - 1) };
         self.sweep_colliders(substeps, origin, progress_at_start, progress);
@@ -716,8 +715,12 @@ impl Engine {
                 }
                 chain.refresh_rest_groups();
             }
-            if self.solver != Solver::Scalar && self.contact_scratch.candidates.is_empty() && substeps > 0 {
-                self.lane_jobs.push(LaneJob { slot, joints: chain.joint_count(), start, target, constants, still });
+            if self.solver != Solver::Scalar && substeps > 0 {
+                let contacts = &mut self.contact_scratch;
+                let candidates = (contacts.lane_candidates.len() as u32, contacts.candidates.len() as u32);
+                contacts.lane_candidates.extend_from_slice(&contacts.candidates);
+                let joints = chain.joint_count();
+                self.lane_jobs.push(LaneJob { slot, joints, start, target, constants, still, candidates });
                 continue;
             }
             let run = ScalarRun { start, target, constants, iterations, h, progress: &self.progress, collider_count };
@@ -729,8 +732,23 @@ impl Engine {
         if !self.lane_jobs.is_empty() {
             let clock = Clock { h: h as f32, iterations, progress: &self.progress };
             let portable = self.solver == Solver::LanesPortable;
-            fallbacks +=
-                self.lanes.step(&mut self.chains, &mut self.lane_jobs, &mut self.lane_leftovers, &clock, portable);
+            let contacts = &mut self.contact_scratch;
+            let step_contacts = StepContacts {
+                candidates: &contacts.lane_candidates,
+                sweeps: &contacts.sweeps,
+                colliders: collider_count,
+                scale: settings.scale,
+            };
+            let (lane_fallbacks, lane_pairs) = self.lanes.step(
+                &mut self.chains,
+                &mut self.lane_jobs,
+                &mut self.lane_leftovers,
+                &clock,
+                &step_contacts,
+                portable,
+            );
+            fallbacks += lane_fallbacks;
+            contact_pairs += lane_pairs;
             lane_chains = self.lane_jobs.len() as u32;
             // Lengths shared by fewer chains than the narrowest lane group are faster on the scalar solver.
             for job in &self.lane_leftovers {
@@ -744,7 +762,15 @@ impl Engine {
                     progress: &self.progress,
                     collider_count,
                 };
-                fallbacks += run.step(chain, None, &mut self.scratch).0;
+                let (first, count) = job.candidates;
+                contacts.candidates.clear();
+                contacts.candidates.extend_from_slice(&contacts.lane_candidates[first as usize..][..count as usize]);
+                if count > 0 {
+                    chain.scaled_radii(settings.scale, &mut contacts.radii);
+                }
+                let (chain_fallbacks, pairs) = run.step(chain, Some(&mut *contacts), &mut self.scratch);
+                fallbacks += chain_fallbacks;
+                contact_pairs += pairs;
             }
             for job in self.lane_jobs.drain(..).chain(self.lane_leftovers.drain(..)) {
                 let chain = self.chains.at_mut(job.slot as usize).expect("live");

@@ -17,8 +17,8 @@ pub(crate) const POLAR_ITERATIONS: u32 = 8;
 
 /// Most rounds of (lengths, contacts) in the last solver iteration; they stop once the contacts move
 /// nothing by more than `CONTACT_SETTLED` of the shortest segment.
-const FINAL_CONTACT_ROUNDS: u32 = 16;
-const CONTACT_SETTLED: f32 = 1e-4;
+pub(crate) const FINAL_CONTACT_ROUNDS: u32 = 16;
+pub(crate) const CONTACT_SETTLED: f32 = 1e-4;
 
 /// The dynamic state of a chain's particles, relative to the engine's origin. Particle 0 is kinematic.
 ///
@@ -120,8 +120,8 @@ pub struct SubstepInput<'a> {
     pub rest: &'a Shape,
     /// Derived from `rest`.
     pub rest_groups: &'a RestGroups,
-    /// The shortest of the segment lengths.
-    pub shortest_segment: f32,
+    /// A contact pass whose corrections stay below this (m) has settled (`Chain::contact_settled`).
+    pub contact_settled: f32,
     /// First substep after placement: a half gravity kick starts the leapfrog.
     pub half_kick: bool,
     /// The colliders this chain can touch during this substep; `None` runs no collision code.
@@ -169,7 +169,7 @@ pub fn substep(
     scratch.reserve(n);
     let h = input.h;
     let RodScratch { p, qp, p_old, constraints } = scratch;
-    let settled = CONTACT_SETTLED * input.shortest_segment;
+    let settled = input.contact_settled;
     if let Some(contacts) = &input.contacts {
         let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
             inextensible::solve(previous, x, lengths, constraints);

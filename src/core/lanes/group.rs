@@ -3,7 +3,9 @@
 
 use glam::{DVec3, Quat, Vec3, Vec3A};
 
+use super::contacts::LaneContacts;
 use super::simd::{D, DV3, F, Mask, Q, V3};
+use crate::core::collider::ColliderSweep;
 use crate::core::inextensible::ConstraintScratch;
 use crate::core::math::Transform;
 use crate::core::rod::{ChainConstants, RodState};
@@ -67,8 +69,13 @@ pub struct LaneGroup<const L: usize> {
     pub(super) mu: Vec<D<L>>,
     pub(super) c_prime: Vec<D<L>>,
     pub(super) d_prime: Vec<D<L>>,
-    // One lane at a time, for the scalar fallback.
+    /// Each lane's contacts this step, and the lanes that have any.
+    pub(super) contacts: Vec<LaneContacts>,
+    pub(super) contact_lanes: Mask<L>,
+    // One lane at a time, for the scalar fallback and the contact pass.
+    pub(super) lane_x: Vec<DVec3>,
     pub(super) lane_p: Vec<DVec3>,
+    pub(super) lane_scratch: Vec<DVec3>,
     pub(super) lane_lengths: Vec<f32>,
     pub(super) constraints: ConstraintScratch,
 }
@@ -126,6 +133,12 @@ impl<const L: usize> LaneGroup<L> {
             fit(v, n, D([0.0; L]));
         }
         fit(&mut self.anchors, settings.substeps, (V3::ZERO, zero_q));
+        if self.contacts.len() < L {
+            self.contacts.resize_with(L, LaneContacts::default);
+        }
+        self.contact_lanes = Mask([false; L]);
+        self.lane_x.reserve(n);
+        self.lane_scratch.reserve(n);
         self.lane_p.reserve(n);
         self.lane_lengths.reserve(n);
         self.constraints.reserve(n);
@@ -165,6 +178,38 @@ impl<const L: usize> LaneGroup<L> {
         self.gravity.set(lane, constants.gravity.to_array());
         self.orientation_weight.0[lane] = constants.orientation_weight;
         self.half_kick.0[lane] = chain.half_kick;
+    }
+
+    /// The contacts of `lane` this step: `candidates` (collider indices, none for a chain that touches
+    /// nothing), the chain's scaled radii (written by `radii`), friction, slop and settled distance (see
+    /// `rod::substep`).
+    pub(crate) fn load_contacts(
+        &mut self,
+        lane: usize,
+        candidates: &[usize],
+        radii: impl FnOnce(&mut Vec<f32>),
+        friction: f32,
+        slop: f32,
+        settled: f32,
+    ) {
+        let contact = &mut self.contacts[lane];
+        contact.candidates.clear();
+        contact.candidates.extend_from_slice(candidates);
+        radii(&mut contact.radii);
+        contact.friction = friction;
+        contact.slop = slop;
+        contact.settled = settled;
+        contact.pass = None;
+        self.contact_lanes.0[lane] = !candidates.is_empty();
+    }
+
+    /// Every contact lane's collider sweeps for substep `s`.
+    pub(crate) fn select_sweeps(&mut self, all: &[ColliderSweep], colliders: usize, s: usize) {
+        for lane in 0..L {
+            if self.contact_lanes.0[lane] {
+                self.contacts[lane].select_sweeps(all, colliders, s);
+            }
+        }
     }
 
     /// The anchor of `lane` at the end of substep `s` (relative to the engine origin).

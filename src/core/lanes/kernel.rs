@@ -6,23 +6,84 @@
 
 use glam::{DVec3, Quat, Vec3};
 
+use super::contacts;
 use super::group::LaneGroup;
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
 use crate::core::inextensible::{self, MAX_NEWTON_ITERATIONS, STAGNATION_LIMIT, TOLERANCE};
 use crate::core::polar::{CONVERGED_ANGLE, MAX_NEWTON_ANGLE, MIN_PIVOT};
-use crate::core::rod::POLAR_ITERATIONS;
+use crate::core::rod::{FINAL_CONTACT_ROUNDS, POLAR_ITERATIONS};
 
 /// Advances every lane of `g` by substep `s` of the current step. Returns the lanes whose direct
 /// inextensibility solve failed in some iteration (the scalar fallback ran for them).
 #[inline(always)]
 pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> Mask<L> {
+    begin_substep(g, s);
+    let mut fell_back = Mask([false; L]);
+    for _ in 0..iterations(g) {
+        fell_back = fell_back.or(iterate(g));
+    }
+    finish_substep(g);
+    fell_back
+}
+
+/// [`substep`] for a group where some lanes may touch colliders, with `rod::substep`'s contact handling on
+/// those lanes (scalar, one lane at a time: [`contacts`]): pre-stabilisation, a contact pass after every
+/// iteration, and the final rounds of lengths then contacts until the contacts settle. The other lanes do
+/// exactly what [`substep`] does. Returns the lanes that fell back and the (segment or particle, collider)
+/// pairs tested.
+#[inline(always)]
+pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> (Mask<L>, u64) {
+    let touching = g.contact_lanes;
+    contacts::pre_stabilise(g, touching);
+    begin_substep(g, s);
+    let iterations = iterations(g);
+    let mut fell_back = Mask([false; L]);
+    let mut pairs = 0;
+    for iteration in 0..iterations {
+        fell_back = fell_back.or(iterate(g));
+        pairs += contacts::collide(g, touching);
+        start_bonds(g);
+        if iteration + 1 == iterations {
+            for _ in 1..FINAL_CONTACT_ROUNDS {
+                let again = contacts::unsettled(g, touching);
+                if !again.any() {
+                    break;
+                }
+                let solved = solve_lengths(g, again);
+                let failed = again.and(solved.not());
+                if failed.any() {
+                    fell_back = fell_back.or(failed);
+                    fall_back(g, failed.not());
+                }
+                pairs += contacts::collide(g, again);
+                start_bonds(g);
+            }
+        }
+    }
+    finish_substep(g);
+    (fell_back, pairs)
+}
+
+#[inline(always)]
+fn iterations<const L: usize>(g: &LaneGroup<L>) -> u32 {
+    if g.shape_matching { g.iterations.max(1) } else { 1 }
+}
+
+/// The start positions' bonds: the direct solve's correction directions until the contact pass moves them.
+#[inline(always)]
+fn start_bonds<const L: usize>(g: &mut LaneGroup<L>) {
+    for k in 0..g.n - 1 {
+        g.start_bonds[k] = g.x[k + 1] - g.x[k];
+    }
+}
+
+/// Correction directions, the kinematic root, and the prediction of the dynamic particles.
+#[inline(always)]
+fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) {
     let n = g.n;
     let h = g.h;
     let (anchor_position, anchor_rotation) = g.anchors[s];
-
-    for k in 0..n - 1 {
-        g.start_bonds[k] = g.x[k + 1] - g.x[k];
-    }
+    start_bonds(g);
 
     // Kinematic root.
     g.p[0] = anchor_position.to_f64() + anchor_rotation.rotate(g.rest_root).to_f64();
@@ -39,22 +100,27 @@ pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> Mask<L> {
         g.p[i] = g.x[i] + (g.v[i] * h).to_f64();
         g.qp[i] = exp_small(g.w[i] * h).mul(g.q[i]).normalize();
     }
+}
 
-    let iterations = if g.shape_matching { g.iterations.max(1) } else { 1 };
-    let mut fell_back = Mask([false; L]);
-    for _ in 0..iterations {
-        if g.shape_matching {
-            match_shape(g);
-        }
-        let solved = solve_lengths(g);
-        if !solved.0.iter().all(|&ok| ok) {
-            fell_back = fell_back.or(solved.not());
-            fall_back(g, solved);
-        }
+/// One solver iteration: shape matching, then the lengths on every lane. Returns the lanes that fell back.
+#[inline(always)]
+fn iterate<const L: usize>(g: &mut LaneGroup<L>) -> Mask<L> {
+    if g.shape_matching {
+        match_shape(g);
     }
+    let solved = solve_lengths(g, Mask([true; L]));
+    if solved.0.iter().all(|&ok| ok) {
+        return Mask([false; L]);
+    }
+    fall_back(g, solved);
+    solved.not()
+}
 
-    // Velocities from positions.
-    let inv_h = 1.0 / h;
+/// Velocities from positions; the end of the substep becomes the start of the next.
+#[inline(always)]
+fn finish_substep<const L: usize>(g: &mut LaneGroup<L>) {
+    let n = g.n;
+    let inv_h = 1.0 / g.h;
     for i in 1..n {
         g.v[i] = (g.p[i] - g.x[i]).to_f32() * inv_h;
         g.w[i] = log_small(g.qp[i].mul(g.q[i].conjugate()).align_hemisphere(Q::IDENTITY)) * inv_h;
@@ -63,7 +129,6 @@ pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> Mask<L> {
     }
     g.x[0] = g.p[0];
     g.q[0] = g.qp[0];
-    fell_back
 }
 
 /// One Gauss-Seidel pass over the shape-matching groups, root to tip (see `rod::match_shape`).
@@ -233,12 +298,12 @@ fn log_small<const L: usize>(q: Q<L>) -> V3<L> {
     r
 }
 
-/// The direct inextensibility solve (`inextensible::newton_along_directions`) on every lane; returns the
-/// lanes where it converged (their `p` holds the result; the others' `p` is untouched).
+/// The direct inextensibility solve (`inextensible::newton_along_directions`) on the lanes of `lanes`;
+/// returns the lanes where it converged (their `p` holds the result; every other lane's `p` is untouched).
 #[inline(always)]
-fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>) -> Mask<L> {
+fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> Mask<L> {
     let m = g.n - 1;
-    let mut active = Mask([true; L]);
+    let mut active = lanes;
     let mut solved = Mask([false; L]);
     let mut previous_worst = D::splat(f64::INFINITY);
     for iteration in 0..MAX_NEWTON_ITERATIONS {
@@ -355,7 +420,7 @@ impl<const L: usize> ForwardPass<L> {
     }
 }
 
-/// The scalar fallback for every lane not in `solved`, one lane at a time.
+/// The scalar fallback for every lane not in `solved` (or not to be solved), one lane at a time.
 #[cold]
 fn fall_back<const L: usize>(g: &mut LaneGroup<L>, solved: Mask<L>) {
     let n = g.n;

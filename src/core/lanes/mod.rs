@@ -15,9 +15,11 @@
 //!   (the two implement the same operations, grouped differently); `tests/lanes.rs` and the accuracy report
 //!   measure by how much. So whether a chain runs in lanes (it has at least 3 siblings of its joint count in
 //!   the step) changes its motion by rounding, never more; the same inputs always give the same bits.
-//! - Chains that may touch a collider in a step take the scalar solver for that step (the contact pass is
-//!   scalar); everything else a chain does (sleeping, teleports, momentum suppression, output) is shared.
+//! - Chains that may touch a collider run in lanes too: the contact pass stays scalar, one lane at a time,
+//!   between the vector phases of the substep ([`contacts`]); everything else a chain does (sleeping,
+//!   teleports, momentum suppression, output) is shared with the scalar solver.
 
+mod contacts;
 mod group;
 mod kernel;
 mod simd;
@@ -26,6 +28,7 @@ use multiversion::multiversion;
 
 use super::arena::Arena;
 use super::chain::Chain;
+use super::collider::ColliderSweep;
 use super::math::Transform;
 use super::rod::ChainConstants;
 use group::{GroupSettings, LaneChain, LaneGroup};
@@ -73,6 +76,27 @@ pub(crate) struct LaneJob {
     pub constants: ChainConstants,
     /// Nothing about the chain changed this step (towards sleeping).
     pub still: bool,
+    /// Where the colliders it can touch this step are in [`StepContacts::candidates`]: (first, count).
+    pub candidates: (u32, u32),
+}
+
+impl LaneJob {
+    /// The colliders the chain can touch this step (indices in collider order).
+    pub fn candidates<'a>(&self, contacts: &StepContacts<'a>) -> &'a [usize] {
+        let (first, count) = self.candidates;
+        &contacts.candidates[first as usize..][..count as usize]
+    }
+}
+
+/// What the lane jobs of a step share for their contacts.
+pub(crate) struct StepContacts<'a> {
+    /// Every job's candidate colliders, one after the other (see [`LaneJob::candidates`]).
+    pub candidates: &'a [usize],
+    /// Every collider's sweep in every substep: `[substep * colliders + collider]`.
+    pub sweeps: &'a [ColliderSweep],
+    pub colliders: usize,
+    /// `EngineSettings::scale` (for the chains' collision radii).
+    pub scale: f32,
 }
 
 impl LaneJob {
@@ -103,15 +127,17 @@ const NARROWEST: usize = 4;
 impl LaneSolver {
     /// Runs every substep of the step for the chains of `jobs` (reordered by joint count) that fill lane
     /// groups, and moves the others (fewer than [`NARROWEST`] of a kind) to `leftovers` for the scalar solver.
-    /// Returns the substeps, summed over the chains, in which the direct inextensibility solve fell back.
+    /// Returns the substeps, summed over the chains, in which the direct inextensibility solve fell back, and
+    /// the contact pairs tested.
     pub(crate) fn step(
         &mut self,
         chains: &mut Arena<Chain>,
         jobs: &mut Vec<LaneJob>,
         leftovers: &mut Vec<LaneJob>,
         clock: &Clock<'_>,
+        contacts: &StepContacts<'_>,
         portable: bool,
-    ) -> u64 {
+    ) -> (u64, u64) {
         jobs.sort_unstable_by_key(|j| (j.key(), j.slot));
         leftovers.clear();
         let mut kept = 0;
@@ -132,7 +158,7 @@ impl LaneSolver {
             first += len;
         }
         jobs.truncate(kept);
-        let mut fallbacks = 0;
+        let (mut fallbacks, mut pairs) = (0, 0);
         let mut rest = &jobs[..];
         while let Some(first) = rest.first() {
             let same = rest.iter().take_while(|j| j.key() == first.key()).count();
@@ -141,17 +167,30 @@ impl LaneSolver {
             while !run.is_empty() {
                 let (group, remaining) = run.split_at(if run.len() >= 8 { 8 } else { 4 });
                 run = remaining;
-                fallbacks += match (group.len(), portable) {
-                    (8, false) => run_group(&mut self.g8, chains, group, clock, substep8),
-                    (8, true) => run_group(&mut self.g8, chains, group, clock, kernel::substep::<8>),
-                    (_, false) => run_group(&mut self.g4, chains, group, clock, substep4),
-                    (_, true) => run_group(&mut self.g4, chains, group, clock, kernel::substep::<4>),
+                let (group_fallbacks, group_pairs) = match (group.len(), portable) {
+                    (8, false) => run_group(&mut self.g8, chains, group, clock, contacts, KERNEL8),
+                    (8, true) => run_group(&mut self.g8, chains, group, clock, contacts, PORTABLE8),
+                    (_, false) => run_group(&mut self.g4, chains, group, clock, contacts, KERNEL4),
+                    (_, true) => run_group(&mut self.g4, chains, group, clock, contacts, PORTABLE4),
                 };
+                fallbacks += group_fallbacks;
+                pairs += group_pairs;
             }
         }
-        fallbacks
+        (fallbacks, pairs)
     }
 }
+
+/// A group's two substep kernels: without contacts, and with the contact pass on the lanes that need it.
+struct Kernels<const L: usize> {
+    plain: fn(&mut LaneGroup<L>, usize) -> Mask<L>,
+    contacts: fn(&mut LaneGroup<L>, usize) -> (Mask<L>, u64),
+}
+
+const KERNEL8: Kernels<8> = Kernels { plain: substep8, contacts: substep_with_contacts8 };
+const KERNEL4: Kernels<4> = Kernels { plain: substep4, contacts: substep_with_contacts4 };
+const PORTABLE8: Kernels<8> = Kernels { plain: kernel::substep::<8>, contacts: kernel::substep_with_contacts::<8> };
+const PORTABLE4: Kernels<4> = Kernels { plain: kernel::substep::<4>, contacts: kernel::substep_with_contacts::<4> };
 
 #[multiversion(targets("x86_64+avx2"))]
 fn substep8(g: &mut LaneGroup<8>, s: usize) -> Mask<8> {
@@ -163,13 +202,24 @@ fn substep4(g: &mut LaneGroup<4>, s: usize) -> Mask<4> {
     kernel::substep(g, s)
 }
 
+#[multiversion(targets("x86_64+avx2"))]
+fn substep_with_contacts8(g: &mut LaneGroup<8>, s: usize) -> (Mask<8>, u64) {
+    kernel::substep_with_contacts(g, s)
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn substep_with_contacts4(g: &mut LaneGroup<4>, s: usize) -> (Mask<4>, u64) {
+    kernel::substep_with_contacts(g, s)
+}
+
 fn run_group<const L: usize>(
     g: &mut LaneGroup<L>,
     chains: &mut Arena<Chain>,
     jobs: &[LaneJob],
     clock: &Clock<'_>,
-    substep: fn(&mut LaneGroup<L>, usize) -> Mask<L>,
-) -> u64 {
+    contacts: &StepContacts<'_>,
+    kernels: Kernels<L>,
+) -> (u64, u64) {
     debug_assert_eq!(jobs.len(), L);
     let substeps = clock.progress.len();
     let first = &jobs[0];
@@ -197,10 +247,26 @@ fn run_group<const L: usize>(
         for s in 0..substeps {
             g.set_anchor(s, lane, &anchor(job, s));
         }
+        g.load_contacts(
+            lane,
+            job.candidates(contacts),
+            |radii| chain.scaled_radii(contacts.scale, radii),
+            chain.params.friction,
+            chain.contact_slop(),
+            chain.contact_settled(),
+        );
     }
-    let mut fallbacks = 0;
+    let touching = g.contact_lanes.any();
+    let (mut fallbacks, mut pairs) = (0, 0);
     for s in 0..substeps {
-        let fell_back = substep(g, s);
+        let fell_back = if touching {
+            g.select_sweeps(contacts.sweeps, contacts.colliders, s);
+            let (fell_back, tested) = (kernels.contacts)(g, s);
+            pairs += tested;
+            fell_back
+        } else {
+            (kernels.plain)(g, s)
+        };
         fallbacks += fell_back.0.iter().filter(|&&f| f).count() as u64;
         // The render interpolation keeps the last two internal poses.
         if s + 2 >= substeps {
@@ -216,5 +282,5 @@ fn run_group<const L: usize>(
         g.store(lane, &mut chain.state);
         chain.half_kick = false;
     }
-    fallbacks
+    (fallbacks, pairs)
 }

@@ -1,0 +1,111 @@
+//! The contact pass of a lane group: `collision`'s scalar code, one lane at a time, between the kernel's
+//! vector phases. Contacts are sparse (a few joints of a strand touch the head or a shoulder), branchy and
+//! different for every chain, so they stay scalar; what the lanes gain is the rest of the substep (shape
+//! matching and the lengths), which a chain near a collider would otherwise run on the scalar solver.
+
+use glam::DVec3;
+
+use super::group::LaneGroup;
+use super::simd::Mask;
+use crate::core::collider::ColliderSweep;
+use crate::core::collision::{self, ContactInput, ContactPass};
+use crate::core::inextensible;
+use crate::core::rod::FINAL_CONTACT_ROUNDS;
+
+/// What one lane's chain needs for its contacts during a step.
+#[derive(Default)]
+pub(crate) struct LaneContacts {
+    /// Indices (in collider order) of the colliders the chain can touch this step.
+    pub candidates: Vec<usize>,
+    /// Their sweeps in the current substep.
+    pub sweeps: Vec<ColliderSweep>,
+    /// Collision radius of each particle (m, scaled).
+    pub radii: Vec<f32>,
+    pub friction: f32,
+    /// `ContactInput::slop`.
+    pub slop: f32,
+    /// A contact pass whose corrections stay below this (m) has settled.
+    pub settled: f32,
+    /// The last contact pass of the current substep.
+    pub pass: Option<ContactPass>,
+}
+
+impl LaneContacts {
+    fn input(&self) -> ContactInput<'_> {
+        ContactInput { colliders: &self.sweeps, radii: &self.radii, friction: self.friction, slop: self.slop }
+    }
+
+    /// The sweeps of substep `s`, from every collider's sweeps of the step (`[substep * colliders + c]`).
+    pub fn select_sweeps(&mut self, all: &[ColliderSweep], colliders: usize, s: usize) {
+        let row = &all[s * colliders..][..colliders];
+        self.sweeps.clear();
+        self.sweeps.extend(self.candidates.iter().map(|&c| row[c]));
+        self.pass = None;
+    }
+}
+
+/// Pre-stabilisation (`collision::pre_stabilise`) of the start positions of the lanes in `lanes`.
+pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) {
+    let n = g.n;
+    for lane in (0..L).filter(|&lane| lanes.0[lane]) {
+        let LaneGroup { x, lengths, lane_x, lane_scratch, lane_lengths, contacts, constraints, .. } = g;
+        extract(&x[..n], lane, lane_x);
+        lane_lengths.clear();
+        lane_lengths.extend(lengths[..n - 1].iter().map(|l| l.0[lane]));
+        lane_scratch.resize(n, DVec3::ZERO);
+        let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
+            inextensible::solve(previous, x, lane_lengths, constraints);
+        };
+        let contact = &contacts[lane];
+        collision::pre_stabilise(
+            lane_x,
+            lane_scratch,
+            &contact.input(),
+            FINAL_CONTACT_ROUNDS,
+            keep_lengths,
+            contact.settled,
+        );
+        write_back(lane_x, lane, &mut x[..n]);
+    }
+}
+
+/// One contact pass (`collision::collide`) on the lanes in `lanes`, moving their positions and, where a joint
+/// was inside already at the start of the substep, their start positions. Returns the pairs tested.
+pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> u64 {
+    let n = g.n;
+    let mut tested = 0;
+    for lane in (0..L).filter(|&lane| lanes.0[lane]) {
+        let LaneGroup { x, p, lane_x, lane_p, contacts, .. } = g;
+        extract(&x[..n], lane, lane_x);
+        extract(&p[..n], lane, lane_p);
+        let contact = &mut contacts[lane];
+        let pass = collision::collide(lane_x, lane_p, &contact.input());
+        contact.pass = Some(pass);
+        tested += pass.tested;
+        write_back(lane_x, lane, &mut x[..n]);
+        write_back(lane_p, lane, &mut p[..n]);
+    }
+    tested
+}
+
+/// The lanes of `lanes` whose last contact pass corrected something by more than their settled distance:
+/// they need another round of lengths then contacts (`rod::substep`'s final rounds).
+pub fn unsettled<const L: usize>(g: &LaneGroup<L>, lanes: Mask<L>) -> Mask<L> {
+    let mut out = Mask([false; L]);
+    for lane in (0..L).filter(|&lane| lanes.0[lane]) {
+        let contact = &g.contacts[lane];
+        out.0[lane] = contact.pass.is_some_and(|pass| pass.touching && pass.deepest > contact.settled);
+    }
+    out
+}
+
+fn extract<const L: usize>(from: &[super::simd::DV3<L>], lane: usize, to: &mut Vec<DVec3>) {
+    to.clear();
+    to.extend(from.iter().map(|v| DVec3::from_array(v.get(lane))));
+}
+
+fn write_back<const L: usize>(from: &[DVec3], lane: usize, to: &mut [super::simd::DV3<L>]) {
+    for (to, from) in to.iter_mut().zip(from) {
+        to.set(lane, from.to_array());
+    }
+}

@@ -47,10 +47,10 @@ use scenes::{
 static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 /// The solver path that ran: the lane solver (the default) with the kernel `kodawari::simd_path` reports for
-/// this CPU, and the scalar solver for chains near colliders and the few left over from the lane groups.
+/// this CPU (contacts scalar, lane by lane), and the scalar solver for the few left over from the lane groups.
 fn solver_path() -> String {
-    const NEAR_COLLIDERS: &str =
-        "chains near colliders and the last 1-3 of a joint count (too few for a group): scalar solver";
+    const NEAR_COLLIDERS: &str = "contacts lane by lane in scalar code; the last 1-3 chains of a joint count (too \
+                                  few for a group): scalar solver";
     let lanes = "lane solver (chains of equal joint count in SIMD groups of 8 or 4)";
     match kodawari::simd_path() {
         "avx2" => format!("{lanes}, avx2 kernel chosen at run time; {NEAR_COLLIDERS}"),

@@ -500,8 +500,8 @@ impl Report {
              rides with the head, so the view direction never changes; *at rest*: heads and camera still, chains \
              settled; *LOD n*: `EngineSettings::lod` (fewer substeps: ns/joint/substep uses the substeps that ran); \
              *scalar solver*: `Engine::set_solver(Solver::Scalar)`, one chain at a time, instead of the default lane \
-             solver (equal-length chains side by side in SIMD lanes; in every variant, chains that may touch a \
-             collider in a step take the scalar solver for that step). \
+             solver (equal-length chains side by side in SIMD lanes; the contact pass of chains that may touch a \
+             collider runs lane by lane in scalar code). \
              Read over 3 frames after each benchmark: heap allocations (a counting allocator), inextensibility \
              solver fallbacks and contact pairs tested (`Stats`), per frame, and the chains the lane solver stepped \
              in the last of them (`Stats::lane_chains`).\n\n\

@@ -116,7 +116,7 @@ namespace Kodawari
     /// They agree up to float rounding; a chain's bits never depend on its lane, its group or the kernel copy.</summary>
     public enum Solver : uint
     {
-        /// <summary>Chains of equal joint count side by side in SIMD lanes (the default). Chains near colliders and the
+        /// <summary>Chains of equal joint count side by side in SIMD lanes (the default; contacts lane by lane). The
         /// last 1 to 3 chains of a joint count (too few for a group) take the scalar solver.</summary>
         Lanes = NativeMethods.KDW_SOLVER_LANES,
         /// <summary><see cref="Lanes"/> with the portable kernel copy whatever the CPU has: the same bits, slower (for

@@ -43,7 +43,7 @@ pub enum Solver {
     /// [`Lanes`](Self::Lanes) with the portable copy of its kernel (SSE2 on x86-64) whatever the CPU has: the
     /// same bits, slower. For checking the determinism policy on one machine.
     LanesPortable,
-    /// One chain at a time: the reference implementation (and what chains near colliders always use).
+    /// One chain at a time: the reference implementation (and what the last 1-3 chains of a joint count use).
     Scalar,
 }
 

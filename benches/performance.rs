@@ -39,8 +39,8 @@ use perf_report::{
 };
 use scene_ffi::{FfiFrame, FfiSceneRun};
 use scenes::{
-    ASLEEP, AWAKE_AT_REST, COLLIDERS, CameraMotion, DISABLED, LIMP, LOD1, LOD2, MASKED_COLLIDERS, PLAIN, PLAIN_SCALAR,
-    PLAIN_STILL, ReadBack, Scene, SceneRun, VIEWS, VIEWS_COLLIDERS, VIEWS_STILL, Variant,
+    ASLEEP, AWAKE_AT_REST, COLLIDERS, COLLIDERS_SCALAR, CameraMotion, DISABLED, LIMP, LOD1, LOD2, MASKED_COLLIDERS,
+    PLAIN, PLAIN_SCALAR, PLAIN_STILL, ReadBack, Scene, SceneRun, VIEWS, VIEWS_COLLIDERS, VIEWS_STILL, Variant,
 };
 
 #[global_allocator]
@@ -277,12 +277,18 @@ const NOISE_FLOOR: &str = "100 x 16 A/A control: two identical plain engines";
 const CAMERA_IGNORED: &str = "100 x 16 without view shapes: orbiting camera vs camera still";
 const MASK_IGNORED: &str = "100 x 16: colliders in the engine but in no chain's mask vs no colliders";
 
-/// The lane solver (B, the default) against the scalar solver (A), interleaved: (what, scene, rounds, block).
-/// A 1000 x 16 frame takes tens of milliseconds, so there fewer, longer blocks.
-const SOLVER_PAIRS: [(&str, &str, usize, Duration); 2] =
-    [(LANES_100, "100x16", PAIRED_ROUNDS, PAIRED_BLOCK), (LANES_1000, "1000x16", 20, Duration::from_millis(100))];
+/// The lane solver (B, the default) against the scalar solver (A), interleaved: (what, scene, A, B, rounds,
+/// block). A 1000 x 16 frame takes tens of milliseconds, so there fewer, longer blocks.
+const SOLVER_PAIRS: [(&str, &str, Variant, Variant, usize, Duration); 4] = [
+    (LANES_100, "100x16", PLAIN_SCALAR, PLAIN, PAIRED_ROUNDS, PAIRED_BLOCK),
+    (LANES_1000, "1000x16", PLAIN_SCALAR, PLAIN, 20, Duration::from_millis(100)),
+    (LANES_100_COLLIDERS, "100x16", COLLIDERS_SCALAR, COLLIDERS, PAIRED_ROUNDS, PAIRED_BLOCK),
+    (LANES_1000_COLLIDERS, "1000x16", COLLIDERS_SCALAR, COLLIDERS, 20, Duration::from_millis(100)),
+];
 const LANES_100: &str = "100 x 16: lane solver vs scalar solver";
 const LANES_1000: &str = "1000 x 16: lane solver vs scalar solver";
+const LANES_100_COLLIDERS: &str = "100 x 16 with colliders: lane solver vs scalar solver";
+const LANES_1000_COLLIDERS: &str = "1000 x 16 with colliders: lane solver vs scalar solver";
 
 fn build_settled(scene_name: &str, variant: Variant) -> SceneRun {
     let scene = SCENES.iter().find(|s| s.name == scene_name).expect("the scene is listed");
@@ -303,8 +309,7 @@ fn interleaved_skips(report: &mut Report) {
             PAIRED_BLOCK,
         ));
     }
-    for (what, scene, rounds, block) in SOLVER_PAIRS {
-        let (a, b) = (PLAIN_SCALAR, PLAIN);
+    for (what, scene, a, b, rounds, block) in SOLVER_PAIRS {
         let (mut run_a, mut run_b) = (build_settled(scene, a), build_settled(scene, b));
         report.paired.push(paired_ratio(
             what,
@@ -608,6 +613,11 @@ fn solver_target(report: &Report) -> Target {
     );
     if let Some(small) = report.paired(LANES_100) {
         let _ = write!(measured, "; 100 x 16: {:.2}x", 1.0 / small.ratio);
+    }
+    for (what, label) in [(LANES_1000_COLLIDERS, "1000 x 16"), (LANES_100_COLLIDERS, "100 x 16")] {
+        if let Some(pair) = report.paired(what) {
+            let _ = write!(measured, "; {label} with colliders: {:.2}x", 1.0 / pair.ratio);
+        }
     }
     if let Some(floor) = report.paired(NOISE_FLOOR) {
         let _ = write!(measured, " (A/A control of the method: {:.3})", floor.ratio);

@@ -189,6 +189,9 @@ pub const VIEWS_STILL: Variant =
 /// Colliders the chains collide with.
 pub const COLLIDERS: Variant =
     Variant { id: "colliders", label: "colliders", colliders: ColliderUse::Colliding, ..PLAIN };
+/// As `COLLIDERS` on the scalar solver (the lane solver runs the contact pass lane by lane).
+pub const COLLIDERS_SCALAR: Variant =
+    Variant { id: "colliders_scalar", label: "colliders, scalar solver", solver: Some(Solver::Scalar), ..COLLIDERS };
 /// Colliders in the engine that no chain's mask selects.
 pub const MASKED_COLLIDERS: Variant =
     Variant { id: "colliders_masked", label: "colliders masked out", colliders: ColliderUse::MaskedOut, ..PLAIN };

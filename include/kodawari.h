@@ -450,7 +450,7 @@ kdw_status kdw_engine_set_def(struct kdw_engine *engine, const struct kdw_engine
 // Sets world gravity, m/s².
 kdw_status kdw_engine_set_gravity(struct kdw_engine *engine, const struct kdw_vec3 *gravity);
 
-// Selects the solver for the chains that touch no collider: `KDW_SOLVER_LANES` (the default),
+// Selects the solver for the engine's chains: `KDW_SOLVER_LANES` (the default),
 // `KDW_SOLVER_LANES_PORTABLE` or `KDW_SOLVER_SCALAR`. They agree up to float rounding; the choice is part of
 // `kdw_engine_state_hash`. Any other value is rejected with `KDW_STATUS_INVALID_ARGUMENT` and changes nothing.
 kdw_status kdw_engine_set_solver(struct kdw_engine *engine,

@@ -71,7 +71,7 @@ inline const char* versionString() noexcept { return kdw_version_string(); }
 /// x86-64 kernel), "neon" or "scalar". Static, never null.
 inline const char* simdPath() noexcept { return kdw_simd_path(); }
 
-/// Which solver steps an engine's chains that touch no collider (KDW_SOLVER_*). They agree up to float
+/// Which solver steps an engine's chains (KDW_SOLVER_*). They agree up to float
 /// rounding; a chain's bits never depend on its lane, its group or the kernel copy.
 enum class Solver : uint32_t {
     /// Chains of equal joint count side by side in SIMD lanes (the default; contacts lane by lane). The last 1
@@ -649,7 +649,7 @@ public:
     }
     /// Sets world gravity, m/s².
     Ret<void> setGravity(const Vec3& gravity) { return detail::check(kdw_engine_set_gravity(handle_, &gravity)); }
-    /// Selects the solver for the chains that touch no collider (Solver::Lanes by default); part of stateHash().
+    /// Selects the solver for the engine's chains (Solver::Lanes by default); part of stateHash().
     /// A value outside Solver fails with KDW_STATUS_INVALID_ARGUMENT and changes nothing.
     Ret<void> setSolver(Solver solver) {
         return detail::check(kdw_engine_set_solver(handle_, static_cast<uint32_t>(solver)));

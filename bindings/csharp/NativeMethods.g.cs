@@ -246,7 +246,7 @@ namespace Kodawari.Native
         internal static extern int kdw_engine_set_gravity(kdw_engine* engine, kdw_vec3* gravity);
 
         /// <summary>
-        ///  Selects the solver for the chains that touch no collider: `KDW_SOLVER_LANES` (the default),
+        ///  Selects the solver for the engine's chains: `KDW_SOLVER_LANES` (the default),
         ///  `KDW_SOLVER_LANES_PORTABLE` or `KDW_SOLVER_SCALAR`. They agree up to float rounding; the choice is part of
         ///  `kdw_engine_state_hash`. Any other value is rejected with `KDW_STATUS_INVALID_ARGUMENT` and changes nothing.
         /// </summary>

@@ -136,7 +136,6 @@ impl Chain {
         self.frame.lengths.iter().sum()
     }
 
-    /// Collision radius of each joint in metres under `scale`, into `out`.
     /// How deep (m) a joint must have been inside a collider at the start of a substep to count as overlapping
     /// since then (`ContactInput::slop`): a share of the chain's shortest segment.
     pub(crate) fn contact_slop(&self) -> f32 {
@@ -148,6 +147,7 @@ impl Chain {
         CONTACT_SETTLED * self.shortest_segment
     }
 
+    /// Collision radius of each joint in metres under `scale`, into `out`.
     pub(crate) fn scaled_radii(&self, scale: f32, out: &mut Vec<f32>) {
         out.clear();
         if self.joint_radii.is_empty() {

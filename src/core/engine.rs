@@ -11,9 +11,10 @@ use super::chain::{Chain, ViewShape, ViewShapeId, relative_rotation};
 use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderSweep};
 use super::collision::ContactInput;
 use super::error::{Error, Result};
-use super::lanes::{Clock, LaneJob, LaneSolver, Solver, StepContacts};
+use super::lanes::{Clock, LaneJob, LaneSolver, Solver};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
 use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, TeleportMode};
+use super::reach::Reach;
 use super::rod::{ChainConstants, RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
 
@@ -143,8 +144,6 @@ struct ContactScratch {
     sweeps: Vec<ColliderSweep>,
     /// Indices (in collider order) of the colliders the current chain can touch this step.
     candidates: Vec<usize>,
-    /// The candidates of every lane job of the step, one after the other (`LaneJob::candidates`).
-    lane_candidates: Vec<usize>,
     /// Their sweeps in the current substep.
     chain_sweeps: Vec<ColliderSweep>,
     radii: Vec<f32>,
@@ -195,7 +194,7 @@ impl Engine {
         }
     }
 
-    /// Which solver steps the chains that touch no collider ([`Solver::Lanes`] by default). Both give the same
+    /// Which solver steps the chains ([`Solver::Lanes`] by default). Both give the same
     /// motion up to float rounding; the scalar one is the reference the lane solver is tested against.
     pub fn set_solver(&mut self, solver: Solver) {
         self.solver = solver;
@@ -613,7 +612,6 @@ impl Engine {
         };
 
         self.progress.clear();
-        self.contact_scratch.lane_candidates.clear();
         self.progress.extend((0..substeps).map(progress));
         let progress_at_start = |s: u64| if s == 0 { 0.0 } else { progress(s - 1) };
         self.sweep_colliders(substeps, origin, progress_at_start, progress);
@@ -657,32 +655,19 @@ impl Engine {
             chain.anchor = anchor_world;
 
             // The colliders this chain can touch during this step: on a layer of its mask and close enough.
-            let contacts = &mut self.contact_scratch;
-            contacts.candidates.clear();
-            if chain.params.collision_mask != 0 && collider_count > 0 && substeps > 0 {
-                chain.scaled_radii(settings.scale, &mut contacts.radii);
-                let thickest = contacts.radii.iter().copied().fold(0.0, f32::max);
-                let reach = chain.rest.positions[0].length() + chain.reach() + thickest;
-                let chain_bound = Bound::of_motion(start.position, target.position, reach);
-                for (c, &collider_slot) in self.collider_order.iter().enumerate() {
-                    let collider = self.colliders.at(collider_slot as usize).expect("live");
-                    let first = &contacts.sweeps[c];
-                    let last = &contacts.sweeps[(substeps as usize - 1) * collider_count + c];
-                    let bound = Bound::of_motion(
-                        first.start.centre.as_vec3(),
-                        last.end.centre.as_vec3(),
-                        collider.shape.bounding_radius(),
-                    );
-                    if chain.params.collision_mask & collider.layers != 0 && chain_bound.touches(&bound) {
-                        contacts.candidates.push(c);
-                    }
-                }
-            }
+            let reach = Reach {
+                colliders: &self.colliders,
+                order: &self.collider_order,
+                sweeps: &self.contact_scratch.sweeps,
+                substeps: substeps as usize,
+                scale: settings.scale,
+            };
+            let (candidates, radii) = (&mut self.contact_scratch.candidates, &mut self.contact_scratch.radii);
+            reach.candidates(chain, &start, &target, candidates, radii);
 
             // Sleeping (SPEC 3.8): skipped while its anchor, rest shape and nearby colliders stay still.
-            let colliders_moving = contacts.candidates.iter().any(|&c| {
-                let (first, last) =
-                    (&contacts.sweeps[c], &contacts.sweeps[(substeps as usize - 1) * collider_count + c]);
+            let colliders_moving = candidates.iter().any(|&c| {
+                let (first, last) = reach.first_and_last(c);
                 first.start.centre != last.end.centre || first.start.rotation != last.end.rotation
             });
             let still = anchor_still && !teleport && !chain.rest_changed && !colliders_moving;
@@ -716,11 +701,7 @@ impl Engine {
                 chain.refresh_rest_groups();
             }
             if self.solver != Solver::Scalar && substeps > 0 {
-                let contacts = &mut self.contact_scratch;
-                let candidates = (contacts.lane_candidates.len() as u32, contacts.candidates.len() as u32);
-                contacts.lane_candidates.extend_from_slice(&contacts.candidates);
-                let joints = chain.joint_count();
-                self.lane_jobs.push(LaneJob { slot, joints, start, target, constants, still, candidates });
+                self.lane_jobs.push(LaneJob { slot, joints: chain.joint_count(), start, target, constants, still });
                 continue;
             }
             let run = ScalarRun { start, target, constants, iterations, h, progress: &self.progress, collider_count };
@@ -732,11 +713,11 @@ impl Engine {
         if !self.lane_jobs.is_empty() {
             let clock = Clock { h: h as f32, iterations, progress: &self.progress };
             let portable = self.solver == Solver::LanesPortable;
-            let contacts = &mut self.contact_scratch;
-            let step_contacts = StepContacts {
-                candidates: &contacts.lane_candidates,
-                sweeps: &contacts.sweeps,
-                colliders: collider_count,
+            let reach = Reach {
+                colliders: &self.colliders,
+                order: &self.collider_order,
+                sweeps: &self.contact_scratch.sweeps,
+                substeps: substeps as usize,
                 scale: settings.scale,
             };
             let (lane_fallbacks, lane_pairs) = self.lanes.step(
@@ -744,7 +725,7 @@ impl Engine {
                 &mut self.lane_jobs,
                 &mut self.lane_leftovers,
                 &clock,
-                &step_contacts,
+                &reach,
                 portable,
             );
             fallbacks += lane_fallbacks;
@@ -762,13 +743,16 @@ impl Engine {
                     progress: &self.progress,
                     collider_count,
                 };
-                let (first, count) = job.candidates;
-                contacts.candidates.clear();
-                contacts.candidates.extend_from_slice(&contacts.lane_candidates[first as usize..][..count as usize]);
-                if count > 0 {
-                    chain.scaled_radii(settings.scale, &mut contacts.radii);
-                }
-                let (chain_fallbacks, pairs) = run.step(chain, Some(&mut *contacts), &mut self.scratch);
+                let reach = Reach {
+                    colliders: &self.colliders,
+                    order: &self.collider_order,
+                    sweeps: &self.contact_scratch.sweeps,
+                    substeps: substeps as usize,
+                    scale: settings.scale,
+                };
+                let (candidates, radii) = (&mut self.contact_scratch.candidates, &mut self.contact_scratch.radii);
+                reach.candidates(chain, &job.start, &job.target, candidates, radii);
+                let (chain_fallbacks, pairs) = run.step(chain, Some(&mut self.contact_scratch), &mut self.scratch);
                 fallbacks += chain_fallbacks;
                 contact_pairs += pairs;
             }
@@ -1085,23 +1069,6 @@ fn check_chain_capacity(chain: &Chain, capacity: usize) -> Result<()> {
 
 fn is_teleport(from: &Transform, to: &Transform, distance: f32, angle: f32) -> bool {
     (to.position - from.position).length() > distance || rotation_angle(from.rotation.inverse() * to.rotation) > angle
-}
-
-/// A sphere holding everything an object may reach during one step.
-struct Bound {
-    centre: Vec3,
-    radius: f32,
-}
-
-impl Bound {
-    /// Of an object reaching `reach` around a point that moves from `from` to `to`.
-    fn of_motion(from: Vec3, to: Vec3, reach: f32) -> Self {
-        Self { centre: (from + to) * 0.5, radius: (to - from).length() * 0.5 + reach }
-    }
-
-    fn touches(&self, other: &Bound) -> bool {
-        (self.centre - other.centre).length() <= self.radius + other.radius
-    }
 }
 
 fn collider_not_found(id: ColliderId) -> Error {

@@ -24,6 +24,7 @@ pub mod lanes;
 pub mod math;
 pub mod params;
 pub mod polar;
+pub(crate) mod reach;
 pub mod rod;
 pub mod shape;
 pub mod sketch;

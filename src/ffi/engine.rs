@@ -77,7 +77,7 @@ pub extern "C" fn kdw_engine_set_gravity(engine: *mut kdw_engine, gravity: *cons
     })
 }
 
-/// Selects the solver for the chains that touch no collider: `KDW_SOLVER_LANES` (the default),
+/// Selects the solver for the engine's chains: `KDW_SOLVER_LANES` (the default),
 /// `KDW_SOLVER_LANES_PORTABLE` or `KDW_SOLVER_SCALAR`. They agree up to float rounding; the choice is part of
 /// `kdw_engine_state_hash`. Any other value is rejected with `KDW_STATUS_INVALID_ARGUMENT` and changes nothing.
 #[unsafe(no_mangle)]

@@ -112,7 +112,7 @@ namespace Kodawari
         Reset = NativeMethods.KDW_TELEPORT_RESET,
     }
 
-    /// <summary>Which solver steps an engine's chains that touch no collider (<c>KDW_SOLVER_*</c>, <see cref="Engine.Solver"/>).
+    /// <summary>Which solver steps an engine's chains (<c>KDW_SOLVER_*</c>, <see cref="Engine.Solver"/>).
     /// They agree up to float rounding; a chain's bits never depend on its lane, its group or the kernel copy.</summary>
     public enum Solver : uint
     {

@@ -180,27 +180,30 @@ impl<const L: usize> LaneGroup<L> {
         self.half_kick.0[lane] = chain.half_kick;
     }
 
-    /// The contacts of `lane` this step: `candidates` (collider indices, none for a chain that touches
-    /// nothing), the chain's scaled radii (written by `radii`), friction, slop and settled distance (see
-    /// `rod::substep`).
+    /// The contacts of `lane` this step: `find` writes the colliders its chain can touch (indices in collider
+    /// order, of `colliders`; none for a chain that touches nothing) and the chain's scaled radii; then its
+    /// friction, slop and settled distance (see `rod::substep`). The buffers hold room for every collider, so
+    /// no later step allocates whichever chain lands in this lane.
     pub(crate) fn load_contacts(
         &mut self,
         lane: usize,
-        candidates: &[usize],
-        radii: impl FnOnce(&mut Vec<f32>),
+        colliders: usize,
+        find: impl FnOnce(&mut Vec<usize>, &mut Vec<f32>),
         friction: f32,
         slop: f32,
         settled: f32,
     ) {
         let contact = &mut self.contacts[lane];
         contact.candidates.clear();
-        contact.candidates.extend_from_slice(candidates);
-        radii(&mut contact.radii);
+        contact.candidates.reserve(colliders);
+        contact.sweeps.clear();
+        contact.sweeps.reserve(colliders);
+        find(&mut contact.candidates, &mut contact.radii);
         contact.friction = friction;
         contact.slop = slop;
         contact.settled = settled;
         contact.pass = None;
-        self.contact_lanes.0[lane] = !candidates.is_empty();
+        self.contact_lanes.0[lane] = !contact.candidates.is_empty();
     }
 
     /// Every contact lane's collider sweeps for substep `s`.

@@ -1,5 +1,5 @@
-//! One substep of a lane group: [`rod::substep`](crate::core::rod::substep) without contacts, for `L`
-//! chains of the same joint count at once. Same algorithm, same constants, same order of operations within
+//! One substep of a lane group: [`rod::substep`](crate::core::rod::substep) for `L` chains of the same
+//! joint count at once (the contact pass, scalar, lane by lane: [`contacts`]). Same algorithm, same constants, same order of operations within
 //! a lane; only the data layout differs (one array per quantity, one lane per chain). Where the scalar
 //! solver branches on a value (convergence, a rotation too large for a series, a failed direct solve), the
 //! lanes keep a mask, and the rare lanes that need the scalar code get it one by one.

@@ -28,13 +28,13 @@ use multiversion::multiversion;
 
 use super::arena::Arena;
 use super::chain::Chain;
-use super::collider::ColliderSweep;
 use super::math::Transform;
+use super::reach::Reach;
 use super::rod::ChainConstants;
 use group::{GroupSettings, LaneChain, LaneGroup};
 use simd::Mask;
 
-/// Which solver steps the chains without contacts.
+/// Which solver steps the chains.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Solver {
     /// Chains of equal joint count side by side in SIMD lanes (the default).
@@ -76,27 +76,6 @@ pub(crate) struct LaneJob {
     pub constants: ChainConstants,
     /// Nothing about the chain changed this step (towards sleeping).
     pub still: bool,
-    /// Where the colliders it can touch this step are in [`StepContacts::candidates`]: (first, count).
-    pub candidates: (u32, u32),
-}
-
-impl LaneJob {
-    /// The colliders the chain can touch this step (indices in collider order).
-    pub fn candidates<'a>(&self, contacts: &StepContacts<'a>) -> &'a [usize] {
-        let (first, count) = self.candidates;
-        &contacts.candidates[first as usize..][..count as usize]
-    }
-}
-
-/// What the lane jobs of a step share for their contacts.
-pub(crate) struct StepContacts<'a> {
-    /// Every job's candidate colliders, one after the other (see [`LaneJob::candidates`]).
-    pub candidates: &'a [usize],
-    /// Every collider's sweep in every substep: `[substep * colliders + collider]`.
-    pub sweeps: &'a [ColliderSweep],
-    pub colliders: usize,
-    /// `EngineSettings::scale` (for the chains' collision radii).
-    pub scale: f32,
 }
 
 impl LaneJob {
@@ -135,7 +114,7 @@ impl LaneSolver {
         jobs: &mut Vec<LaneJob>,
         leftovers: &mut Vec<LaneJob>,
         clock: &Clock<'_>,
-        contacts: &StepContacts<'_>,
+        reach: &Reach<'_>,
         portable: bool,
     ) -> (u64, u64) {
         jobs.sort_unstable_by_key(|j| (j.key(), j.slot));
@@ -168,10 +147,10 @@ impl LaneSolver {
                 let (group, remaining) = run.split_at(if run.len() >= 8 { 8 } else { 4 });
                 run = remaining;
                 let (group_fallbacks, group_pairs) = match (group.len(), portable) {
-                    (8, false) => run_group(&mut self.g8, chains, group, clock, contacts, KERNEL8),
-                    (8, true) => run_group(&mut self.g8, chains, group, clock, contacts, PORTABLE8),
-                    (_, false) => run_group(&mut self.g4, chains, group, clock, contacts, KERNEL4),
-                    (_, true) => run_group(&mut self.g4, chains, group, clock, contacts, PORTABLE4),
+                    (8, false) => run_group(&mut self.g8, chains, group, clock, reach, KERNEL8),
+                    (8, true) => run_group(&mut self.g8, chains, group, clock, reach, PORTABLE8),
+                    (_, false) => run_group(&mut self.g4, chains, group, clock, reach, KERNEL4),
+                    (_, true) => run_group(&mut self.g4, chains, group, clock, reach, PORTABLE4),
                 };
                 fallbacks += group_fallbacks;
                 pairs += group_pairs;
@@ -217,7 +196,7 @@ fn run_group<const L: usize>(
     chains: &mut Arena<Chain>,
     jobs: &[LaneJob],
     clock: &Clock<'_>,
-    contacts: &StepContacts<'_>,
+    reach: &Reach<'_>,
     kernels: Kernels<L>,
 ) -> (u64, u64) {
     debug_assert_eq!(jobs.len(), L);
@@ -249,8 +228,8 @@ fn run_group<const L: usize>(
         }
         g.load_contacts(
             lane,
-            job.candidates(contacts),
-            |radii| chain.scaled_radii(contacts.scale, radii),
+            reach.order.len(),
+            |candidates, radii| reach.candidates(chain, &job.start, &job.target, candidates, radii),
             chain.params.friction,
             chain.contact_slop(),
             chain.contact_settled(),
@@ -260,7 +239,7 @@ fn run_group<const L: usize>(
     let (mut fallbacks, mut pairs) = (0, 0);
     for s in 0..substeps {
         let fell_back = if touching {
-            g.select_sweeps(contacts.sweeps, contacts.colliders, s);
+            g.select_sweeps(reach.sweeps, reach.order.len(), s);
             let (fell_back, tested) = (kernels.contacts)(g, s);
             pairs += tested;
             fell_back

@@ -98,7 +98,7 @@ namespace Kodawari
             set { Library.Check(NativeMethods.kdw_engine_set_gravity(Ptr, (kdw_vec3*)&value)); }
         }
 
-        /// <summary>The solver for the chains that touch no collider (<see cref="Kodawari.Solver.Lanes"/> by default):
+        /// <summary>The solver for the engine's chains (<see cref="Kodawari.Solver.Lanes"/> by default):
         /// the solvers agree up to float rounding, and the choice is part of <see cref="StateHash"/>. Setting a value
         /// outside <see cref="Kodawari.Solver"/> throws (<see cref="KodawariStatus.InvalidArgument"/>) and changes
         /// nothing. Allocation-free.</summary>

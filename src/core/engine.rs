@@ -54,7 +54,8 @@ struct ScalarRun<'a> {
     h: f64,
     /// Fraction of the anchor motion reached at the end of each substep.
     progress: &'a [f32],
-    collider_count: usize,
+    /// The step's colliders and their sweeps.
+    reach: &'a Reach<'a>,
 }
 
 impl ScalarRun<'_> {
@@ -66,7 +67,7 @@ impl ScalarRun<'_> {
         mut contacts: Option<&mut ContactScratch>,
         scratch: &mut RodScratch,
     ) -> (u64, u64) {
-        let (h, collider_count) = (self.h, self.collider_count);
+        let (h, collider_count) = (self.h, self.reach.order.len());
         let slop = chain.contact_slop();
         let substeps = self.progress.len();
         let (mut fallbacks, mut contact_pairs) = (0, 0);
@@ -74,7 +75,7 @@ impl ScalarRun<'_> {
             let anchor = self.start.interpolate(&self.target, progress);
             let touching = contacts.as_ref().is_some_and(|c| !c.candidates.is_empty());
             if let Some(contacts) = contacts.as_deref_mut().filter(|_| touching) {
-                let row = &contacts.sweeps[s * collider_count..][..collider_count];
+                let row = &self.reach.sweeps[s * collider_count..][..collider_count];
                 contacts.chain_sweeps.clear();
                 contacts.chain_sweeps.extend(contacts.candidates.iter().map(|&c| row[c]));
             }
@@ -128,6 +129,8 @@ pub struct Engine {
     joint_count: usize,
     scratch: RodScratch,
     contact_scratch: ContactScratch,
+    /// Every collider's sweep in every substep of the current step: `[substep * colliders + collider]`.
+    collider_sweeps: Vec<ColliderSweep>,
     solver: Solver,
     lanes: LaneSolver,
     /// The chains the lane solver steps in the current step, and the anchor progress of each substep.
@@ -140,8 +143,6 @@ pub struct Engine {
 /// Buffers of the contact pass, reused across steps.
 #[derive(Default)]
 struct ContactScratch {
-    /// Every collider's sweep in every substep of the current step: `[substep * colliders + collider]`.
-    sweeps: Vec<ColliderSweep>,
     /// Indices (in collider order) of the colliders the current chain can touch this step.
     candidates: Vec<usize>,
     /// Their sweeps in the current substep.
@@ -167,6 +168,7 @@ impl Engine {
             joint_count: 0,
             scratch: RodScratch::default(),
             contact_scratch: ContactScratch::default(),
+            collider_sweeps: Vec::new(),
             solver: Solver::default(),
             lanes: LaneSolver::default(),
             lane_jobs: Vec::new(),
@@ -615,7 +617,13 @@ impl Engine {
         self.progress.extend((0..substeps).map(progress));
         let progress_at_start = |s: u64| if s == 0 { 0.0 } else { progress(s - 1) };
         self.sweep_colliders(substeps, origin, progress_at_start, progress);
-        let collider_count = self.collider_order.len();
+        let reach = Reach {
+            colliders: &self.colliders,
+            order: &self.collider_order,
+            sweeps: &self.collider_sweeps,
+            substeps: substeps as usize,
+            scale: settings.scale,
+        };
         let teleport_distance = settings.teleport_distance * settings.scale;
 
         let mut fallbacks = 0u64;
@@ -655,13 +663,6 @@ impl Engine {
             chain.anchor = anchor_world;
 
             // The colliders this chain can touch during this step: on a layer of its mask and close enough.
-            let reach = Reach {
-                colliders: &self.colliders,
-                order: &self.collider_order,
-                sweeps: &self.contact_scratch.sweeps,
-                substeps: substeps as usize,
-                scale: settings.scale,
-            };
             let (candidates, radii) = (&mut self.contact_scratch.candidates, &mut self.contact_scratch.radii);
             reach.candidates(chain, &start, &target, candidates, radii);
 
@@ -704,7 +705,7 @@ impl Engine {
                 self.lane_jobs.push(LaneJob { slot, joints: chain.joint_count(), start, target, constants, still });
                 continue;
             }
-            let run = ScalarRun { start, target, constants, iterations, h, progress: &self.progress, collider_count };
+            let run = ScalarRun { start, target, constants, iterations, h, progress: &self.progress, reach: &reach };
             let (chain_fallbacks, pairs) = run.step(chain, Some(&mut self.contact_scratch), &mut self.scratch);
             fallbacks += chain_fallbacks;
             contact_pairs += pairs;
@@ -713,13 +714,6 @@ impl Engine {
         if !self.lane_jobs.is_empty() {
             let clock = Clock { h: h as f32, iterations, progress: &self.progress };
             let portable = self.solver == Solver::LanesPortable;
-            let reach = Reach {
-                colliders: &self.colliders,
-                order: &self.collider_order,
-                sweeps: &self.contact_scratch.sweeps,
-                substeps: substeps as usize,
-                scale: settings.scale,
-            };
             let (lane_fallbacks, lane_pairs) = self.lanes.step(
                 &mut self.chains,
                 &mut self.lane_jobs,
@@ -741,14 +735,7 @@ impl Engine {
                     iterations,
                     h,
                     progress: &self.progress,
-                    collider_count,
-                };
-                let reach = Reach {
-                    colliders: &self.colliders,
-                    order: &self.collider_order,
-                    sweeps: &self.contact_scratch.sweeps,
-                    substeps: substeps as usize,
-                    scale: settings.scale,
+                    reach: &reach,
                 };
                 let (candidates, radii) = (&mut self.contact_scratch.candidates, &mut self.contact_scratch.radii);
                 reach.candidates(chain, &job.start, &job.target, candidates, radii);
@@ -789,7 +776,7 @@ impl Engine {
         at_end: impl Fn(u64) -> f32,
     ) {
         let settings = self.settings;
-        let sweeps = &mut self.contact_scratch.sweeps;
+        let sweeps = &mut self.collider_sweeps;
         sweeps.clear();
         for &slot in &self.collider_order {
             let collider = self.colliders.at_mut(slot as usize).expect("live");

@@ -6,7 +6,7 @@
 use glam::DVec3;
 
 use super::group::LaneGroup;
-use super::simd::Mask;
+use super::simd::{DV3, Mask};
 use crate::core::collider::ColliderSweep;
 use crate::core::collision::{self, ContactInput, ContactPass};
 use crate::core::inextensible;
@@ -99,12 +99,14 @@ pub fn unsettled<const L: usize>(g: &LaneGroup<L>, lanes: Mask<L>) -> Mask<L> {
     out
 }
 
-fn extract<const L: usize>(from: &[super::simd::DV3<L>], lane: usize, to: &mut Vec<DVec3>) {
+/// One lane of `from` into `to`.
+pub(super) fn extract<const L: usize>(from: &[DV3<L>], lane: usize, to: &mut Vec<DVec3>) {
     to.clear();
     to.extend(from.iter().map(|v| DVec3::from_array(v.get(lane))));
 }
 
-fn write_back<const L: usize>(from: &[DVec3], lane: usize, to: &mut [super::simd::DV3<L>]) {
+/// `from` into one lane of `to`.
+pub(super) fn write_back<const L: usize>(from: &[DVec3], lane: usize, to: &mut [DV3<L>]) {
     for (to, from) in to.iter_mut().zip(from) {
         to.set(lane, from.to_array());
     }

@@ -4,7 +4,7 @@
 //! solver branches on a value (convergence, a rotation too large for a series, a failed direct solve), the
 //! lanes keep a mask, and the rare lanes that need the scalar code get it one by one.
 
-use glam::{DVec3, Quat, Vec3};
+use glam::{Quat, Vec3};
 
 use super::contacts;
 use super::group::LaneGroup;
@@ -428,13 +428,10 @@ fn fall_back<const L: usize>(g: &mut LaneGroup<L>, solved: Mask<L>) {
         if solved.0[lane] {
             continue;
         }
-        g.lane_p.clear();
-        g.lane_p.extend(g.p[..n].iter().map(|p| DVec3::from_array(p.get(lane))));
+        contacts::extract(&g.p[..n], lane, &mut g.lane_p);
         g.lane_lengths.clear();
         g.lane_lengths.extend(g.lengths[..n - 1].iter().map(|l| l.0[lane]));
         inextensible::solve_fallback(&mut g.lane_p, &g.lane_lengths, &mut g.constraints);
-        for (p, solved) in g.p[..n].iter_mut().zip(&g.lane_p) {
-            p.set(lane, solved.to_array());
-        }
+        contacts::write_back(&g.lane_p, lane, &mut g.p[..n]);
     }
 }

@@ -1,0 +1,38 @@
+//! Runs one of the performance report's scenes (`benches/support/scenes.rs`) for a fixed number of frames,
+//! for instruction counts that do not depend on the machine's load, e.g. the linearity figures of
+//! `docs/robustness.md` (bug 1):
+//! `valgrind --tool=callgrind target/release/examples/scene_cost 60 1x1000_hair scalar`, then divide the total
+//! by the dynamic joints and substeps printed. Scenes: `100x16`, `1x1000` (0.8 m rope), `1x1000_hair`
+//! (2.5 cm segments); solvers: `lanes` (default), `scalar`.
+
+#[path = "../benches/support/scenes.rs"]
+mod scenes;
+
+use scenes::{PLAIN, PLAIN_SCALAR, ReadBack, Scene, SceneRun};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let usage = "usage: scene_cost FRAMES 100x16|1x1000|1x1000_hair [lanes|scalar]";
+    let frames: u64 = args.first().and_then(|f| f.parse().ok()).expect(usage);
+    let scene = match args.get(1).map(String::as_str) {
+        Some("100x16") => Scene::uniform("100x16", 100, 16),
+        Some("1x1000") => Scene::uniform("1x1000", 1, 1000),
+        Some("1x1000_hair") => Scene::uniform("1x1000_hair", 1, 1000).with_segment(0.025),
+        _ => panic!("{usage}"),
+    };
+    let variant = if args.get(2).is_some_and(|s| s == "scalar") { PLAIN_SCALAR } else { PLAIN };
+    let mut run = SceneRun::new(&scene, variant, ReadBack::World).expect("the scene builds");
+    for _ in 0..frames {
+        run.frame();
+    }
+    let stats = run.engine.stats();
+    println!(
+        "{} ({}), {}: {} dynamic joints, {} substeps, {} solver fallbacks",
+        scene.name,
+        scene.shape_label(),
+        variant.label,
+        scene.dynamic_joints(),
+        stats.substeps_total,
+        stats.solver_fallbacks
+    );
+}

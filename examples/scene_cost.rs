@@ -2,7 +2,7 @@
 //! for instruction counts that do not depend on the machine's load, e.g. the linearity figures of
 //! `docs/robustness.md` (bug 1):
 //! `valgrind --tool=callgrind target/release/examples/scene_cost 60 1x1000_hair scalar`, then divide the total
-//! by the dynamic joints and substeps printed. Scenes: `100x16`, `1x1000` (0.8 m rope), `1x1000_hair`
+//! by the dynamic joints and substeps printed. Scenes: `100x16`, `1000x16`, `1x1000` (0.8 m rope), `1x1000_hair`
 //! (2.5 cm segments); solvers: `lanes` (default), `scalar`.
 
 #[path = "../benches/support/scenes.rs"]
@@ -12,10 +12,11 @@ use scenes::{PLAIN, PLAIN_SCALAR, ReadBack, Scene, SceneRun};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: scene_cost FRAMES 100x16|1x1000|1x1000_hair [lanes|scalar]";
+    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar]";
     let frames: u64 = args.first().and_then(|f| f.parse().ok()).expect(usage);
     let scene = match args.get(1).map(String::as_str) {
         Some("100x16") => Scene::uniform("100x16", 100, 16),
+        Some("1000x16") => Scene::uniform("1000x16", 1000, 16),
         Some("1x1000") => Scene::uniform("1x1000", 1, 1000),
         Some("1x1000_hair") => Scene::uniform("1x1000_hair", 1, 1000).with_segment(0.025),
         _ => panic!("{usage}"),

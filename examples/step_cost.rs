@@ -21,9 +21,12 @@ const SPACING: f32 = 0.03;
 
 fn scene(chains: usize, joints: usize, spacing: f32) -> Engine {
     let mut engine = Engine::new(EngineSettings::default()).expect("default settings are valid");
-    // `KDW_SOLVER=scalar` measures the scalar reference solver instead of the lane solver.
-    if std::env::var("KDW_SOLVER").is_ok_and(|s| s == "scalar") {
-        engine.set_solver(kodawari::Solver::Scalar);
+    // `KDW_SOLVER=scalar` measures the scalar reference solver instead of the lane solver, `portable` the lane
+    // solver's portable (SSE2) kernel.
+    match std::env::var("KDW_SOLVER").as_deref() {
+        Ok("scalar") => engine.set_solver(kodawari::Solver::Scalar),
+        Ok("portable") => engine.set_solver(kodawari::Solver::LanesPortable),
+        _ => {}
     }
     let base: Vec<Transform> =
         (0..joints).map(|i| Transform::new(Vec3::new(0.0, 0.1 + spacing * i as f32, 0.0), Quat::IDENTITY)).collect();

@@ -10,19 +10,38 @@ use super::contacts;
 use super::group::LaneGroup;
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
 use crate::core::inextensible::{self, MAX_NEWTON_ITERATIONS, STAGNATION_LIMIT, TOLERANCE};
-use crate::core::polar::{CONVERGED_ANGLE, MAX_NEWTON_ANGLE, MIN_PIVOT};
-use crate::core::rod::{FINAL_CONTACT_ROUNDS, POLAR_ITERATIONS};
+use crate::core::rod::FINAL_CONTACT_ROUNDS;
+
+/// The vector phases of a substep, each compiled as its own function (a copy per instruction set:
+/// `mod.rs`). One function holding the whole substep is too large for the compiler's vectoriser: it split
+/// most 8-lane operations into 4-lane halves and spilled them (measured: about 8x the instructions of the
+/// operation count).
+pub struct Phases<const L: usize> {
+    pub begin: fn(&mut LaneGroup<L>, usize),
+    pub match_shape: fn(&mut LaneGroup<L>),
+    pub solve_lengths: fn(&mut LaneGroup<L>, Mask<L>) -> Mask<L>,
+    pub finish: fn(&mut LaneGroup<L>),
+}
+
+impl<const L: usize> Phases<L> {
+    /// The phases compiled for the baseline instruction set.
+    pub const PORTABLE: Self = Self {
+        begin: begin_substep,
+        match_shape: |g| match_shape(g, super::polar::extract_rotation),
+        solve_lengths,
+        finish: finish_substep,
+    };
+}
 
 /// Advances every lane of `g` by substep `s` of the current step. Returns the lanes whose direct
 /// inextensibility solve failed in some iteration (the scalar fallback ran for them).
-#[inline(always)]
-pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> Mask<L> {
-    begin_substep(g, s);
+pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, phases: &Phases<L>) -> Mask<L> {
+    (phases.begin)(g, s);
     let mut fell_back = Mask([false; L]);
     for _ in 0..iterations(g) {
-        fell_back = fell_back.or(iterate(g));
+        fell_back = fell_back.or(iterate(g, phases));
     }
-    finish_substep(g);
+    (phases.finish)(g);
     fell_back
 }
 
@@ -31,16 +50,15 @@ pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> Mask<L> {
 /// iteration, and the final rounds of lengths then contacts until the contacts settle. The other lanes do
 /// exactly what [`substep`] does. Returns the lanes that fell back and the (segment or particle, collider)
 /// pairs tested.
-#[inline(always)]
-pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> (Mask<L>, u64) {
+pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, phases: &Phases<L>) -> (Mask<L>, u64) {
     let touching = g.contact_lanes;
     contacts::pre_stabilise(g, touching);
-    begin_substep(g, s);
+    (phases.begin)(g, s);
     let iterations = iterations(g);
     let mut fell_back = Mask([false; L]);
     let mut pairs = 0;
     for iteration in 0..iterations {
-        fell_back = fell_back.or(iterate(g));
+        fell_back = fell_back.or(iterate(g, phases));
         pairs += contacts::collide(g, touching);
         start_bonds(g);
         if iteration + 1 == iterations {
@@ -49,7 +67,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> 
                 if !again.any() {
                     break;
                 }
-                let solved = solve_lengths(g, again);
+                let solved = (phases.solve_lengths)(g, again);
                 let failed = again.and(solved.not());
                 if failed.any() {
                     fell_back = fell_back.or(failed);
@@ -60,7 +78,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize) -> 
             }
         }
     }
-    finish_substep(g);
+    (phases.finish)(g);
     (fell_back, pairs)
 }
 
@@ -79,7 +97,7 @@ fn start_bonds<const L: usize>(g: &mut LaneGroup<L>) {
 
 /// Correction directions, the kinematic root, and the prediction of the dynamic particles.
 #[inline(always)]
-fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) {
+pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) {
     let n = g.n;
     let h = g.h;
     let (anchor_position, anchor_rotation) = g.anchors[s];
@@ -103,12 +121,11 @@ fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) {
 }
 
 /// One solver iteration: shape matching, then the lengths on every lane. Returns the lanes that fell back.
-#[inline(always)]
-fn iterate<const L: usize>(g: &mut LaneGroup<L>) -> Mask<L> {
+fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>) -> Mask<L> {
     if g.shape_matching {
-        match_shape(g);
+        (phases.match_shape)(g);
     }
-    let solved = solve_lengths(g, Mask([true; L]));
+    let solved = (phases.solve_lengths)(g, Mask([true; L]));
     if solved.0.iter().all(|&ok| ok) {
         return Mask([false; L]);
     }
@@ -118,7 +135,7 @@ fn iterate<const L: usize>(g: &mut LaneGroup<L>) -> Mask<L> {
 
 /// Velocities from positions; the end of the substep becomes the start of the next.
 #[inline(always)]
-fn finish_substep<const L: usize>(g: &mut LaneGroup<L>) {
+pub fn finish_substep<const L: usize>(g: &mut LaneGroup<L>) {
     let n = g.n;
     let inv_h = 1.0 / g.h;
     for i in 1..n {
@@ -133,7 +150,7 @@ fn finish_substep<const L: usize>(g: &mut LaneGroup<L>) {
 
 /// One Gauss-Seidel pass over the shape-matching groups, root to tip (see `rod::match_shape`).
 #[inline(always)]
-fn match_shape<const L: usize>(g: &mut LaneGroup<L>) {
+pub fn match_shape<const L: usize>(g: &mut LaneGroup<L>, polar: fn(&M3<L>, &mut Q<L>) -> M3<L>) {
     let n = g.n;
     let alpha = g.alpha;
     let alpha64 = alpha.to_f64();
@@ -176,7 +193,7 @@ fn match_shape<const L: usize>(g: &mut LaneGroup<L>) {
             (c, a)
         };
         let mut rotation = g.group_rotation[i];
-        let frame = extract_rotation(&a, &mut rotation);
+        let frame = polar(&a, &mut rotation);
         g.group_rotation[i] = rotation;
         g.p[lo] = pull_to_goal(g.p[lo], c, frame.mul_vec3(r_lo), alpha64);
         g.p[i] = pull_to_goal(g.p[i], c, frame.mul_vec3(r_mid), alpha64);
@@ -197,62 +214,6 @@ fn orientation_term<const L: usize>(g: &LaneGroup<L>, j: usize, weight: F<L>) ->
 fn pull_to_goal<const L: usize>(p: DV3<L>, centre: DV3<L>, offset: V3<L>, alpha: D<L>) -> DV3<L> {
     let goal = centre + offset.to_f64();
     p + (goal - p).scale(alpha)
-}
-
-/// `polar::extract_rotation` on every lane; a lane stops changing once it has converged.
-#[inline(always)]
-fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>) -> M3<L> {
-    let norm = (a.x_axis.length_squared() + a.y_axis.length_squared() + a.z_axis.length_squared()).sqrt();
-    let guard = norm * 1e-9 + f32::MIN_POSITIVE;
-    let mut active = Mask([true; L]);
-    for _ in 0..POLAR_ITERATIONS {
-        let r = M3::from_quat(*q);
-        // Columns of `S = R^T A`.
-        let s = M3 {
-            x_axis: r.transpose_mul(a.x_axis),
-            y_axis: r.transpose_mul(a.y_axis),
-            z_axis: r.transpose_mul(a.z_axis),
-        };
-        let g = V3 { x: s.y_axis.z - s.z_axis.y, y: s.z_axis.x - s.x_axis.z, z: s.x_axis.y - s.y_axis.x };
-        let trace = s.x_axis.x + s.y_axis.y + s.z_axis.z;
-        let muller = g.scale(F::splat(1.0) / (trace.abs() + guard));
-        let converged = muller.length_squared().lt(F::splat(CONVERGED_ANGLE * CONVERGED_ANGLE));
-        active = active.and(converged.not());
-        if !active.any() {
-            break;
-        }
-        let step = newton_step(&s, g, trace, muller);
-        let turned = q.mul(exp_small(step));
-        *q = Q::select(active, turned.scale(F::splat(1.5) - turned.dot(turned) * 0.5), *q);
-    }
-    M3::from_quat(*q)
-}
-
-/// `polar::newton_step`, or the Müller step `muller` in the lanes where the Newton step is not trusted.
-#[inline(always)]
-fn newton_step<const L: usize>(s: &M3<L>, g: V3<L>, trace: F<L>, muller: V3<L>) -> V3<L> {
-    let (h00, h11, h22) = (trace - s.x_axis.x, trace - s.y_axis.y, trace - s.z_axis.z);
-    let h01 = (s.y_axis.x + s.x_axis.y) * -0.5;
-    let h02 = (s.z_axis.x + s.x_axis.z) * -0.5;
-    let h12 = (s.z_axis.y + s.y_axis.z) * -0.5;
-    let c00 = h11 * h22 - h12 * h12;
-    let c01 = h02 * h12 - h01 * h22;
-    let c02 = h01 * h12 - h02 * h11;
-    let c11 = h00 * h22 - h02 * h02;
-    let c12 = h01 * h02 - h00 * h12;
-    let c22 = h00 * h11 - h01 * h01;
-    let det = h00 * c00 + h01 * c01 + h02 * c02;
-    let pivot = trace.abs() * MIN_PIVOT;
-    let definite = h00.gt(pivot).and(c22.gt(pivot * pivot)).and(det.gt(pivot * pivot * pivot));
-    let inv_det = F::splat(1.0) / det;
-    let step = V3 {
-        x: c00 * g.x + c01 * g.y + c02 * g.z,
-        y: c01 * g.x + c11 * g.y + c12 * g.z,
-        z: c02 * g.x + c12 * g.y + c22 * g.z,
-    }
-    .scale(inv_det);
-    let short = step.length_squared().le(F::splat(MAX_NEWTON_ANGLE * MAX_NEWTON_ANGLE));
-    V3::select(definite.and(short), step, muller)
 }
 
 /// `math::exp_small` on every lane: the series where the turn is short, `Quat::from_scaled_axis` per lane
@@ -301,7 +262,7 @@ fn log_small<const L: usize>(q: Q<L>) -> V3<L> {
 /// The direct inextensibility solve (`inextensible::newton_along_directions`) on the lanes of `lanes`;
 /// returns the lanes where it converged (their `p` holds the result; every other lane's `p` is untouched).
 #[inline(always)]
-fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> Mask<L> {
+pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> Mask<L> {
     let m = g.n - 1;
     let mut active = lanes;
     let mut solved = Mask([false; L]);

@@ -22,6 +22,7 @@
 mod contacts;
 mod group;
 mod kernel;
+mod polar;
 mod simd;
 
 use multiversion::multiversion;
@@ -32,7 +33,8 @@ use super::math::Transform;
 use super::reach::Reach;
 use super::rod::ChainConstants;
 use group::{GroupSettings, LaneChain, LaneGroup};
-use simd::Mask;
+use kernel::Phases;
+use simd::{M3, Mask, Q};
 
 /// Which solver steps the chains.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -147,10 +149,10 @@ impl LaneSolver {
                 let (group, remaining) = run.split_at(if run.len() >= 8 { 8 } else { 4 });
                 run = remaining;
                 let (group_fallbacks, group_pairs) = match (group.len(), portable) {
-                    (8, false) => run_group(&mut self.g8, chains, group, clock, reach, KERNEL8),
-                    (8, true) => run_group(&mut self.g8, chains, group, clock, reach, PORTABLE8),
-                    (_, false) => run_group(&mut self.g4, chains, group, clock, reach, KERNEL4),
-                    (_, true) => run_group(&mut self.g4, chains, group, clock, reach, PORTABLE4),
+                    (8, false) => run_group(&mut self.g8, chains, group, clock, reach, &WIDE8),
+                    (8, true) => run_group(&mut self.g8, chains, group, clock, reach, &Phases::PORTABLE),
+                    (_, false) => run_group(&mut self.g4, chains, group, clock, reach, &WIDE4),
+                    (_, true) => run_group(&mut self.g4, chains, group, clock, reach, &Phases::PORTABLE),
                 };
                 fallbacks += group_fallbacks;
                 pairs += group_pairs;
@@ -160,36 +162,41 @@ impl LaneSolver {
     }
 }
 
-/// A group's two substep kernels: without contacts, and with the contact pass on the lanes that need it.
-struct Kernels<const L: usize> {
-    plain: fn(&mut LaneGroup<L>, usize) -> Mask<L>,
-    contacts: fn(&mut LaneGroup<L>, usize) -> (Mask<L>, u64),
+/// The kernel's phases compiled with AVX2 where the CPU has it, one dispatching function per phase and width.
+macro_rules! wide_phases {
+    ($name:ident, $lanes:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $finish:ident) => {
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
+            kernel::begin_substep(g, s)
+        }
+
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $match_shape(g: &mut LaneGroup<$lanes>) {
+            kernel::match_shape(g, $polar)
+        }
+
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $polar(a: &M3<$lanes>, q: &mut Q<$lanes>) -> M3<$lanes> {
+            polar::extract_rotation(a, q)
+        }
+
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $solve(g: &mut LaneGroup<$lanes>, lanes: Mask<$lanes>) -> Mask<$lanes> {
+            kernel::solve_lengths(g, lanes)
+        }
+
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $finish(g: &mut LaneGroup<$lanes>) {
+            kernel::finish_substep(g)
+        }
+
+        const $name: Phases<$lanes> =
+            Phases { begin: $begin, match_shape: $match_shape, solve_lengths: $solve, finish: $finish };
+    };
 }
 
-const KERNEL8: Kernels<8> = Kernels { plain: substep8, contacts: substep_with_contacts8 };
-const KERNEL4: Kernels<4> = Kernels { plain: substep4, contacts: substep_with_contacts4 };
-const PORTABLE8: Kernels<8> = Kernels { plain: kernel::substep::<8>, contacts: kernel::substep_with_contacts::<8> };
-const PORTABLE4: Kernels<4> = Kernels { plain: kernel::substep::<4>, contacts: kernel::substep_with_contacts::<4> };
-
-#[multiversion(targets("x86_64+avx2"))]
-fn substep8(g: &mut LaneGroup<8>, s: usize) -> Mask<8> {
-    kernel::substep(g, s)
-}
-
-#[multiversion(targets("x86_64+avx2"))]
-fn substep4(g: &mut LaneGroup<4>, s: usize) -> Mask<4> {
-    kernel::substep(g, s)
-}
-
-#[multiversion(targets("x86_64+avx2"))]
-fn substep_with_contacts8(g: &mut LaneGroup<8>, s: usize) -> (Mask<8>, u64) {
-    kernel::substep_with_contacts(g, s)
-}
-
-#[multiversion(targets("x86_64+avx2"))]
-fn substep_with_contacts4(g: &mut LaneGroup<4>, s: usize) -> (Mask<4>, u64) {
-    kernel::substep_with_contacts(g, s)
-}
+wide_phases!(WIDE8, 8, begin8, match_shape8, polar8, solve_lengths8, finish8);
+wide_phases!(WIDE4, 4, begin4, match_shape4, polar4, solve_lengths4, finish4);
 
 fn run_group<const L: usize>(
     g: &mut LaneGroup<L>,
@@ -197,7 +204,7 @@ fn run_group<const L: usize>(
     jobs: &[LaneJob],
     clock: &Clock<'_>,
     reach: &Reach<'_>,
-    kernels: Kernels<L>,
+    phases: &Phases<L>,
 ) -> (u64, u64) {
     debug_assert_eq!(jobs.len(), L);
     let substeps = clock.progress.len();
@@ -240,11 +247,11 @@ fn run_group<const L: usize>(
     for s in 0..substeps {
         let fell_back = if touching {
             g.select_sweeps(reach.sweeps, reach.order.len(), s);
-            let (fell_back, tested) = (kernels.contacts)(g, s);
+            let (fell_back, tested) = kernel::substep_with_contacts(g, s, phases);
             pairs += tested;
             fell_back
         } else {
-            (kernels.plain)(g, s)
+            kernel::substep(g, s, phases)
         };
         fallbacks += fell_back.0.iter().filter(|&&f| f).count() as u64;
         // The render interpolation keeps the last two internal poses.

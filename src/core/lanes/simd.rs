@@ -484,12 +484,6 @@ impl<const L: usize> M3<L> {
         Self { x_axis: self.x_axis.scale(s), y_axis: self.y_axis.scale(s), z_axis: self.z_axis.scale(s) }
     }
 
-    /// `self^T v`.
-    #[inline(always)]
-    pub fn transpose_mul(self, v: V3<L>) -> V3<L> {
-        V3 { x: self.x_axis.dot(v), y: self.y_axis.dot(v), z: self.z_axis.dot(v) }
-    }
-
     #[inline(always)]
     pub fn mul_vec3(self, v: V3<L>) -> V3<L> {
         self.x_axis.scale(v.x) + self.y_axis.scale(v.y) + self.z_axis.scale(v.z)

@@ -8,8 +8,9 @@ use glam::{Quat, Vec3};
 
 use super::contacts;
 use super::group::LaneGroup;
+use super::lengths::{Passes, solve_lengths};
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
-use crate::core::inextensible::{self, MAX_NEWTON_ITERATIONS, STAGNATION_LIMIT, TOLERANCE};
+use crate::core::inextensible;
 use crate::core::rod::FINAL_CONTACT_ROUNDS;
 
 /// The vector phases of a substep, each compiled as its own function (a copy per instruction set:
@@ -28,7 +29,7 @@ impl<const L: usize> Phases<L> {
     pub const PORTABLE: Self = Self {
         begin: begin_substep,
         match_shape: |g| match_shape(g, super::polar::extract_rotation),
-        solve_lengths,
+        solve_lengths: |g, lanes| solve_lengths(g, lanes, &Passes::PORTABLE),
         finish: finish_substep,
     };
 }
@@ -257,128 +258,6 @@ fn log_small<const L: usize>(q: Q<L>) -> V3<L> {
         }
     }
     r
-}
-
-/// The direct inextensibility solve (`inextensible::newton_along_directions`) on the lanes of `lanes`;
-/// returns the lanes where it converged (their `p` holds the result; every other lane's `p` is untouched).
-#[inline(always)]
-pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> Mask<L> {
-    let m = g.n - 1;
-    let mut active = lanes;
-    let mut solved = Mask([false; L]);
-    let mut previous_worst = D::splat(f64::INFINITY);
-    for iteration in 0..MAX_NEWTON_ITERATIONS {
-        let mut pass = ForwardPass::<L>::new();
-        if iteration == 0 {
-            for k in 0..m {
-                let b = g.p[k + 1] - g.p[k];
-                pass.row(k, b, g);
-            }
-        } else {
-            g.corrected[0] = g.p[0];
-            for k in 0..m {
-                g.corrected[k + 1] = g.p[k + 1] + shift(g, k + 1);
-                let b = g.corrected[k + 1] - g.corrected[k];
-                pass.row(k, b, g);
-            }
-        }
-        let converged = active.and(pass.converged(previous_worst));
-        if converged.any() {
-            if iteration > 0 {
-                for j in 1..=m {
-                    g.p[j] = DV3::select(converged, g.corrected[j], g.p[j]);
-                }
-            }
-            solved = solved.or(converged);
-            active = active.and(converged.not());
-        }
-        active = active.and(pass.diverging(previous_worst).not()).and(pass.pivots_usable());
-        previous_worst = pass.worst;
-        if !active.any() {
-            break;
-        }
-        // Back substitution (the Thomas algorithm's pass back), into the multipliers of the active lanes.
-        let mut next = D::splat(0.0);
-        for k in (0..m).rev() {
-            next = g.d_prime[k] - g.c_prime[k] * next;
-            let updated = if iteration == 0 { next } else { g.mu[k] + next };
-            g.mu[k] = D::select(active, updated, g.mu[k]);
-        }
-        active = active.and(next.is_finite());
-        if !active.any() {
-            break;
-        }
-    }
-    solved
-}
-
-/// How far the multipliers move particle `j >= 1` along the start bonds.
-#[inline(always)]
-fn shift<const L: usize>(g: &LaneGroup<L>, j: usize) -> DV3<L> {
-    let m = g.n - 1;
-    let pulled = g.start_bonds[j - 1].scale(g.mu[j - 1]);
-    if j < m { pulled - g.start_bonds[j].scale(g.mu[j]) } else { pulled }
-}
-
-/// `inextensible::ForwardPass` on every lane.
-struct ForwardPass<const L: usize> {
-    worst: D<L>,
-    scale: D<L>,
-    smallest_pivot: D<L>,
-    c_last: D<L>,
-    d_last: D<L>,
-}
-
-impl<const L: usize> ForwardPass<L> {
-    #[inline(always)]
-    fn new() -> Self {
-        Self {
-            worst: D::splat(0.0),
-            scale: D::splat(0.0),
-            smallest_pivot: D::splat(f64::INFINITY),
-            c_last: D::splat(0.0),
-            d_last: D::splat(0.0),
-        }
-    }
-
-    #[inline(always)]
-    fn row(&mut self, k: usize, b: DV3<L>, g: &mut LaneGroup<L>) {
-        let m = g.n - 1;
-        let f = b.length_squared() - g.length_squared[k];
-        let error = (f * g.inverse_length_squared[k]).abs();
-        // As the scalar pass: a NaN error is ignored here.
-        self.worst = D::select(error.gt(self.worst), error, self.worst);
-        let d = &g.start_bonds;
-        let diagonal = if k > 0 { b.dot(d[k]) * 2.0 } else { b.dot(d[k]) };
-        let lower = if k > 0 { -b.dot(d[k - 1]) } else { D::splat(0.0) };
-        let upper = if k + 1 < m { -b.dot(d[k + 1]) } else { D::splat(0.0) };
-        let den = diagonal - lower * self.c_last;
-        let diagonal_size = diagonal.abs();
-        self.scale = D::select(diagonal_size.gt(self.scale), diagonal_size, self.scale);
-        let pivot_size = den.abs();
-        self.smallest_pivot = D::select(pivot_size.lt(self.smallest_pivot), pivot_size, self.smallest_pivot);
-        let inv = D::splat(1.0) / den;
-        self.c_last = upper * inv;
-        self.d_last = (f * -0.5 - lower * self.d_last) * inv;
-        g.c_prime[k] = self.c_last;
-        g.d_prime[k] = self.d_last;
-    }
-
-    #[inline(always)]
-    fn converged(&self, previous_worst: D<L>) -> Mask<L> {
-        let floor = self.worst.gt(previous_worst * 0.5).and(self.worst.lt(D::splat(STAGNATION_LIMIT)));
-        self.worst.le(D::splat(TOLERANCE)).or(floor)
-    }
-
-    #[inline(always)]
-    fn diverging(&self, previous_worst: D<L>) -> Mask<L> {
-        self.worst.gt(previous_worst)
-    }
-
-    #[inline(always)]
-    fn pivots_usable(&self) -> Mask<L> {
-        self.scale.gt(D::splat(0.0)).and(self.smallest_pivot.gt(self.scale * inextensible::MIN_PIVOT))
-    }
 }
 
 /// The scalar fallback for every lane not in `solved` (or not to be solved), one lane at a time.

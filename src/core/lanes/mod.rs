@@ -22,6 +22,7 @@
 mod contacts;
 mod group;
 mod kernel;
+mod lengths;
 mod polar;
 mod simd;
 
@@ -34,7 +35,8 @@ use super::reach::Reach;
 use super::rod::ChainConstants;
 use group::{GroupSettings, LaneChain, LaneGroup};
 use kernel::Phases;
-use simd::{M3, Mask, Q};
+use lengths::{ForwardPass, Passes};
+use simd::{D, DV3, M3, Mask, Q};
 
 /// Which solver steps the chains.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -164,7 +166,7 @@ impl LaneSolver {
 
 /// The kernel's phases compiled with AVX2 where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $finish:ident) => {
+    ($name:ident, $lanes:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident) => {
         #[multiversion(targets("x86_64+avx2"))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
             kernel::begin_substep(g, s)
@@ -182,8 +184,39 @@ macro_rules! wide_phases {
 
         #[multiversion(targets("x86_64+avx2"))]
         fn $solve(g: &mut LaneGroup<$lanes>, lanes: Mask<$lanes>) -> Mask<$lanes> {
-            kernel::solve_lengths(g, lanes)
+            lengths::solve_lengths(g, lanes, &$passes)
         }
+
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $first(
+            p: &[DV3<$lanes>],
+            d: &[DV3<$lanes>],
+            l2: &[D<$lanes>],
+            inv_l2: &[D<$lanes>],
+            c_prime: &mut [D<$lanes>],
+            d_prime: &mut [D<$lanes>],
+            pass: &mut ForwardPass<$lanes>,
+        ) {
+            lengths::first_pass(p, d, l2, inv_l2, c_prime, d_prime, pass)
+        }
+
+        #[allow(clippy::too_many_arguments)]
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $corrected(
+            p: &[DV3<$lanes>],
+            corrected: &mut [DV3<$lanes>],
+            mu: &[D<$lanes>],
+            d: &[DV3<$lanes>],
+            l2: &[D<$lanes>],
+            inv_l2: &[D<$lanes>],
+            c_prime: &mut [D<$lanes>],
+            d_prime: &mut [D<$lanes>],
+            pass: &mut ForwardPass<$lanes>,
+        ) {
+            lengths::corrected_pass(p, corrected, mu, d, l2, inv_l2, c_prime, d_prime, pass)
+        }
+
+        const $passes: Passes<$lanes> = Passes { first: $first, corrected: $corrected };
 
         #[multiversion(targets("x86_64+avx2"))]
         fn $finish(g: &mut LaneGroup<$lanes>) {
@@ -195,8 +228,8 @@ macro_rules! wide_phases {
     };
 }
 
-wide_phases!(WIDE8, 8, begin8, match_shape8, polar8, solve_lengths8, finish8);
-wide_phases!(WIDE4, 4, begin4, match_shape4, polar4, solve_lengths4, finish4);
+wide_phases!(WIDE8, 8, begin8, match_shape8, polar8, solve_lengths8, PASSES8, first_pass8, corrected_pass8, finish8);
+wide_phases!(WIDE4, 4, begin4, match_shape4, polar4, solve_lengths4, PASSES4, first_pass4, corrected_pass4, finish4);
 
 fn run_group<const L: usize>(
     g: &mut LaneGroup<L>,

@@ -262,6 +262,8 @@ pub struct M3<const L: usize> {
 
 macro_rules! vec3_ops {
     ($ty:ident, $lane:ident, $elem:ty) => {
+        // The same set for both vector types; not every operation is used on both.
+        #[allow(dead_code)]
         impl<const L: usize> $ty<L> {
             pub const ZERO: Self = Self { x: $lane([0.0; L]), y: $lane([0.0; L]), z: $lane([0.0; L]) };
 

@@ -1,0 +1,264 @@
+//! The direct inextensibility solve (`inextensible::newton_along_directions`) on every lane of a group.
+//!
+//! The forward pass, which does most of the work, is written as loops over the lanes whose bodies are one
+//! lane's scalar arithmetic, for the reason given in [`polar`](super::polar): with 8-lane array operations
+//! on double-precision 3-vectors the vectoriser grouped the 24 values of a vector across its components
+//! (4-, 2- and 1-wide pieces), and most of the pass ran in 128-bit or scalar instructions. The arithmetic is
+//! the same, operation for operation, so the bits are the same.
+
+use super::group::LaneGroup;
+use super::simd::{D, DV3, Mask};
+use crate::core::inextensible::{MAX_NEWTON_ITERATIONS, MIN_PIVOT, STAGNATION_LIMIT, TOLERANCE};
+
+type DVec = [f64; 3];
+
+/// The two kinds of forward pass, as functions compiled for the instruction set at hand (`mod.rs`). They
+/// must stay real functions taking every buffer as a separate slice: only across such a call does the
+/// compiler know the buffers do not overlap, which it must to vectorise the lane loops (inlined, with the
+/// slices cut from the group's `Vec`s, the loops stayed scalar: measured with callgrind, 66 % scalar
+/// instructions).
+pub struct Passes<const L: usize> {
+    pub first: FirstPass<L>,
+    pub corrected: CorrectedPass<L>,
+}
+
+pub type FirstPass<const L: usize> =
+    fn(&[DV3<L>], &[DV3<L>], &[D<L>], &[D<L>], &mut [D<L>], &mut [D<L>], &mut ForwardPass<L>);
+pub type CorrectedPass<const L: usize> =
+    fn(&[DV3<L>], &mut [DV3<L>], &[D<L>], &[DV3<L>], &[D<L>], &[D<L>], &mut [D<L>], &mut [D<L>], &mut ForwardPass<L>);
+
+impl<const L: usize> Passes<L> {
+    /// The passes compiled for the baseline instruction set.
+    pub const PORTABLE: Self = Self { first: first_pass, corrected: corrected_pass };
+}
+
+/// The direct solve on the lanes of `lanes`; returns the lanes where it converged (their `p` holds the
+/// result; every other lane's `p` is untouched).
+#[inline(always)]
+pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, passes: &Passes<L>) -> Mask<L> {
+    let m = g.n - 1;
+    let mut active = lanes;
+    let mut solved = Mask([false; L]);
+    let mut previous_worst = D::splat(f64::INFINITY);
+    for iteration in 0..MAX_NEWTON_ITERATIONS {
+        let pass = forward_pass(g, iteration > 0, passes);
+        let converged = active.and(pass.converged(previous_worst));
+        if converged.any() {
+            if iteration > 0 {
+                for j in 1..=m {
+                    g.p[j] = DV3::select(converged, g.corrected[j], g.p[j]);
+                }
+            }
+            solved = solved.or(converged);
+            active = active.and(converged.not());
+        }
+        active = active.and(pass.diverging(previous_worst).not()).and(pass.pivots_usable());
+        previous_worst = pass.worst;
+        if !active.any() {
+            break;
+        }
+        // Back substitution (the Thomas algorithm's pass back), into the multipliers of the active lanes.
+        let mut next = D::splat(0.0);
+        for k in (0..m).rev() {
+            next = g.d_prime[k] - g.c_prime[k] * next;
+            let updated = if iteration == 0 { next } else { g.mu[k] + next };
+            g.mu[k] = D::select(active, updated, g.mu[k]);
+        }
+        active = active.and(next.is_finite());
+        if !active.any() {
+            break;
+        }
+    }
+    solved
+}
+
+/// One pass root to tip: the bonds under the current multipliers (`corrected`; the bonds of `p` itself
+/// before the first step), their errors, and the forward elimination of the Newton system.
+#[inline(always)]
+fn forward_pass<const L: usize>(g: &mut LaneGroup<L>, corrected: bool, passes: &Passes<L>) -> ForwardPass<L> {
+    let m = g.n - 1;
+    let mut pass = ForwardPass::new();
+    let (d, l2, inv_l2) = (&g.start_bonds[..m], &g.length_squared[..m], &g.inverse_length_squared[..m]);
+    let (c_prime, d_prime) = (&mut g.c_prime[..m], &mut g.d_prime[..m]);
+    if corrected {
+        (passes.corrected)(&g.p[..=m], &mut g.corrected[..=m], &g.mu[..m], d, l2, inv_l2, c_prime, d_prime, &mut pass);
+    } else {
+        (passes.first)(&g.p[..=m], d, l2, inv_l2, c_prime, d_prime, &mut pass);
+    }
+    pass
+}
+
+/// Bond `k`'s row inputs.
+#[inline(always)]
+fn bond<'a, const L: usize>(k: usize, d: &'a [DV3<L>], l2: &'a [D<L>], inv_l2: &'a [D<L>]) -> Bond<'a, L> {
+    let last = d.len() - 1;
+    Bond {
+        k,
+        last,
+        length_squared: &l2[k],
+        inverse_length_squared: &inv_l2[k],
+        lower: &d[k.saturating_sub(1)],
+        own: &d[k],
+        upper: &d[(k + 1).min(last)],
+    }
+}
+
+/// The first pass: the bonds of `p`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn first_pass<const L: usize>(
+    p: &[DV3<L>],
+    d: &[DV3<L>],
+    l2: &[D<L>],
+    inv_l2: &[D<L>],
+    c_prime: &mut [D<L>],
+    d_prime: &mut [D<L>],
+    pass: &mut ForwardPass<L>,
+) {
+    for k in 0..d.len() {
+        let bond = bond(k, d, l2, inv_l2);
+        let (tip, start) = (&p[k + 1], &p[k]);
+        let (c_row, d_row) = (&mut c_prime[k], &mut d_prime[k]);
+        for lane in 0..L {
+            pass.row(lane, sub(tip.get(lane), start.get(lane)), &bond, c_row, d_row);
+        }
+    }
+}
+
+/// A later pass: `p` moved by the multipliers `mu` along the start bonds (`inextensible::shift`), kept in
+/// `corrected`. Every slice is indexed before the lane loops: a bounds check inside one keeps it scalar.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn corrected_pass<const L: usize>(
+    p: &[DV3<L>],
+    corrected: &mut [DV3<L>],
+    mu: &[D<L>],
+    d: &[DV3<L>],
+    l2: &[D<L>],
+    inv_l2: &[D<L>],
+    c_prime: &mut [D<L>],
+    d_prime: &mut [D<L>],
+    pass: &mut ForwardPass<L>,
+) {
+    let m = d.len();
+    corrected[0] = p[0];
+    for k in 0..m {
+        let bond = bond(k, d, l2, inv_l2);
+        let tip = &p[k + 1];
+        let (own_mu, upper_mu) = (&mu[k], &mu[(k + 1).min(m - 1)]);
+        let end = k + 1 == m;
+        let (below, at) = corrected.split_at_mut(k + 1);
+        let (start, moved_tip) = (&below[k], &mut at[0]);
+        let (c_row, d_row) = (&mut c_prime[k], &mut d_prime[k]);
+        for lane in 0..L {
+            let pulled = scale(bond.own.get(lane), own_mu.0[lane]);
+            let pushed = scale(bond.upper.get(lane), upper_mu.0[lane]);
+            let shift = if end { pulled } else { sub(pulled, pushed) };
+            let moved = add(tip.get(lane), shift);
+            moved_tip.set(lane, moved);
+            pass.row(lane, sub(moved, start.get(lane)), &bond, c_row, d_row);
+        }
+    }
+}
+
+/// What one bond's row of the pass reads.
+struct Bond<'a, const L: usize> {
+    k: usize,
+    /// The last bond's index.
+    last: usize,
+    length_squared: &'a D<L>,
+    inverse_length_squared: &'a D<L>,
+    /// The start bonds before, of and after this one (clamped at the ends, where they do not count).
+    lower: &'a DV3<L>,
+    own: &'a DV3<L>,
+    upper: &'a DV3<L>,
+}
+
+/// `inextensible::ForwardPass` on every lane.
+pub struct ForwardPass<const L: usize> {
+    worst: D<L>,
+    scale: D<L>,
+    smallest_pivot: D<L>,
+    c_last: D<L>,
+    d_last: D<L>,
+}
+
+impl<const L: usize> ForwardPass<L> {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            worst: D::splat(0.0),
+            scale: D::splat(0.0),
+            smallest_pivot: D::splat(f64::INFINITY),
+            c_last: D::splat(0.0),
+            d_last: D::splat(0.0),
+        }
+    }
+
+    /// Bond `bond.k` of `lane` with vector `b`: its error, and its row of the forward elimination.
+    #[inline(always)]
+    fn row(&mut self, lane: usize, b: DVec, bond: &Bond<'_, L>, c_prime: &mut D<L>, d_prime: &mut D<L>) {
+        let f = dot(b, b) - bond.length_squared.0[lane];
+        let error = (f * bond.inverse_length_squared.0[lane]).abs();
+        // As the scalar pass: a NaN error is ignored here.
+        let worst = self.worst.0[lane];
+        self.worst.0[lane] = if error > worst { error } else { worst };
+        // Every product is computed and the ends' unused ones dropped by selects: loads under a condition keep
+        // the loop from being vectorised.
+        let (own, lower, upper) =
+            (dot(b, bond.own.get(lane)), -dot(b, bond.lower.get(lane)), -dot(b, bond.upper.get(lane)));
+        let diagonal = if bond.k > 0 { own * 2.0 } else { own };
+        let lower = if bond.k > 0 { lower } else { 0.0 };
+        let upper = if bond.k < bond.last { upper } else { 0.0 };
+        let den = diagonal - lower * self.c_last.0[lane];
+        let diagonal_size = diagonal.abs();
+        let scale = self.scale.0[lane];
+        self.scale.0[lane] = if diagonal_size > scale { diagonal_size } else { scale };
+        let pivot_size = den.abs();
+        let smallest = self.smallest_pivot.0[lane];
+        self.smallest_pivot.0[lane] = if pivot_size < smallest { pivot_size } else { smallest };
+        let inv = 1.0 / den;
+        let c_last = upper * inv;
+        let d_last = (f * -0.5 - lower * self.d_last.0[lane]) * inv;
+        self.c_last.0[lane] = c_last;
+        self.d_last.0[lane] = d_last;
+        c_prime.0[lane] = c_last;
+        d_prime.0[lane] = d_last;
+    }
+
+    #[inline(always)]
+    fn converged(&self, previous_worst: D<L>) -> Mask<L> {
+        let floor = self.worst.gt(previous_worst * 0.5).and(self.worst.lt(D::splat(STAGNATION_LIMIT)));
+        self.worst.le(D::splat(TOLERANCE)).or(floor)
+    }
+
+    #[inline(always)]
+    fn diverging(&self, previous_worst: D<L>) -> Mask<L> {
+        self.worst.gt(previous_worst)
+    }
+
+    #[inline(always)]
+    fn pivots_usable(&self) -> Mask<L> {
+        self.scale.gt(D::splat(0.0)).and(self.smallest_pivot.gt(self.scale * MIN_PIVOT))
+    }
+}
+
+#[inline(always)]
+fn dot(a: DVec, b: DVec) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn add(a: DVec, b: DVec) -> DVec {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+#[inline(always)]
+fn sub(a: DVec, b: DVec) -> DVec {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
+fn scale(a: DVec, s: f64) -> DVec {
+    [a[0] * s, a[1] * s, a[2] * s]
+}

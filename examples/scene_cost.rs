@@ -3,16 +3,18 @@
 //! `docs/robustness.md` (bug 1):
 //! `valgrind --tool=callgrind target/release/examples/scene_cost 60 1x1000_hair scalar`, then divide the total
 //! by the dynamic joints and substeps printed. Scenes: `100x16`, `1000x16`, `1x1000` (0.8 m rope), `1x1000_hair`
-//! (2.5 cm segments); solvers: `lanes` (default), `scalar`.
+//! (2.5 cm segments); variants: `lanes` (default), `scalar`, `colliders`
+//! (the head sphere, shoulders and ground of the report's colliders variant, on the lane solver) and
+//! `colliders_scalar`.
 
 #[path = "../benches/support/scenes.rs"]
 mod scenes;
 
-use scenes::{PLAIN, PLAIN_SCALAR, ReadBack, Scene, SceneRun};
+use scenes::{COLLIDERS, COLLIDERS_SCALAR, PLAIN, PLAIN_SCALAR, ReadBack, Scene, SceneRun};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar]";
+    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar|colliders|colliders_scalar]";
     let frames: u64 = args.first().and_then(|f| f.parse().ok()).expect(usage);
     let scene = match args.get(1).map(String::as_str) {
         Some("100x16") => Scene::uniform("100x16", 100, 16),
@@ -21,7 +23,12 @@ fn main() {
         Some("1x1000_hair") => Scene::uniform("1x1000_hair", 1, 1000).with_segment(0.025),
         _ => panic!("{usage}"),
     };
-    let variant = if args.get(2).is_some_and(|s| s == "scalar") { PLAIN_SCALAR } else { PLAIN };
+    let variant = match args.get(2).map(String::as_str) {
+        Some("scalar") => PLAIN_SCALAR,
+        Some("colliders") => COLLIDERS,
+        Some("colliders_scalar") => COLLIDERS_SCALAR,
+        _ => PLAIN,
+    };
     let mut run = SceneRun::new(&scene, variant, ReadBack::World).expect("the scene builds");
     for _ in 0..frames {
         run.frame();

@@ -34,8 +34,38 @@ pub struct ContactInput<'a> {
 ///
 /// A joint that was already inside at the start of the substep is pushed out with `start` moving along, so
 /// the push does not become velocity (see also [`pre_stabilise`]).
-pub fn collide(start: &mut [DVec3], p: &mut [DVec3], input: &ContactInput<'_>) -> ContactPass {
-    collide_at(start, p, input, Pose::End)
+pub fn collide(
+    start: &mut [DVec3],
+    p: &mut [DVec3],
+    input: &ContactInput<'_>,
+    bounds: &mut SegmentBounds,
+) -> ContactPass {
+    collide_at(start, p, input, Pose::End, bounds)
+}
+
+/// Each segment's quick-reject bound for one contact pass, shared by every sphere and capsule the pass
+/// tests (computing it per collider cost three square roots per segment and collider). Reusable scratch.
+#[derive(Default)]
+pub struct SegmentBounds {
+    /// Per segment: its midpoint, and how far from it the segment and its particles can reach during the
+    /// substep (half its length, the larger travel of its ends since the substep's start, its thickness).
+    bounds: Vec<(DVec3, f64)>,
+}
+
+impl SegmentBounds {
+    pub fn reserve(&mut self, segments: usize) {
+        self.bounds.reserve(segments.saturating_sub(self.bounds.len()));
+    }
+
+    fn compute(&mut self, start: &[DVec3], p: &[DVec3], radii: &[f32]) {
+        self.bounds.clear();
+        self.bounds.extend((0..p.len() - 1).map(|k| {
+            let half = (p[k + 1] - p[k]).length() * 0.5;
+            let travel = (p[k] - start[k]).length().max((p[k + 1] - start[k + 1]).length());
+            let thickness = radii[k].max(radii[k + 1]) as f64;
+            (p[k].midpoint(p[k + 1]), thickness + half + travel)
+        }));
+    }
 }
 
 /// Which of a sweep's poses the contacts are resolved against.
@@ -60,16 +90,17 @@ pub fn pre_stabilise(
     rounds: u32,
     mut keep_lengths: impl FnMut(&[DVec3], &mut [DVec3]),
     settled: f32,
+    bounds: &mut SegmentBounds,
 ) -> bool {
     scratch.copy_from_slice(x);
-    let mut pass = collide_at(scratch, x, input, Pose::Start);
+    let mut pass = collide_at(scratch, x, input, Pose::Start, bounds);
     // Joints left on a surface by the last substep touch it within rounding: only a real overlap needs rounds.
     if pass.deepest <= settled {
         return false;
     }
     for _ in 1..rounds {
         keep_lengths(scratch, x);
-        pass = collide_at(scratch, x, input, Pose::Start);
+        pass = collide_at(scratch, x, input, Pose::Start, bounds);
         if pass.deepest <= settled {
             break;
         }
@@ -77,16 +108,31 @@ pub fn pre_stabilise(
     true
 }
 
-fn collide_at(start: &mut [DVec3], p: &mut [DVec3], input: &ContactInput<'_>, pose: Pose) -> ContactPass {
+fn collide_at(
+    start: &mut [DVec3],
+    p: &mut [DVec3],
+    input: &ContactInput<'_>,
+    pose: Pose,
+    bounds: &mut SegmentBounds,
+) -> ContactPass {
     let mut result = ContactPass { tested: 0, touching: false, deepest: 0.0 };
+    let outside =
+        |sweep: &ColliderSweep| matches!(sweep.shape, ColliderShape::Sphere { .. } | ColliderShape::Capsule { .. });
+    if input.colliders.iter().any(outside) {
+        bounds.compute(start, p, input.radii);
+    }
+    // How far the pass has moved particles and start positions since the bounds were computed, summed: the
+    // quick reject widens by three times that to stay conservative (a segment's midpoint, half length and
+    // travel each change by at most the sum).
+    let mut drift = 0.0;
     for sweep in input.colliders {
         let pass = match sweep.shape {
-            ColliderShape::Plane => collide_plane(start, p, &at(sweep, pose), input),
+            ColliderShape::Plane => collide_plane(start, p, &at(sweep, pose), input, &mut drift),
             ColliderShape::InsideSphere { .. } | ColliderShape::InsideCapsule { .. } => {
-                collide_inside(start, p, &at(sweep, pose), input)
+                collide_inside(start, p, &at(sweep, pose), input, &mut drift)
             }
             ColliderShape::Sphere { .. } | ColliderShape::Capsule { .. } => {
-                collide_outside(start, p, &at(sweep, pose), input)
+                collide_outside(start, p, &at(sweep, pose), input, &bounds.bounds, &mut drift)
             }
         };
         result.tested += pass.tested;
@@ -114,7 +160,13 @@ pub struct ContactPass {
     pub deepest: f32,
 }
 
-fn collide_plane(start: &mut [DVec3], p: &mut [DVec3], sweep: &ColliderSweep, input: &ContactInput<'_>) -> ContactPass {
+fn collide_plane(
+    start: &mut [DVec3],
+    p: &mut [DVec3],
+    sweep: &ColliderSweep,
+    input: &ContactInput<'_>,
+    drift: &mut f64,
+) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
     for j in 1..p.len() {
@@ -126,7 +178,7 @@ fn collide_plane(start: &mut [DVec3], p: &mut [DVec3], sweep: &ColliderSweep, in
             let overlapping_at_start = moved.y < input.radii[j] - input.slop;
             deepest = deepest.max(depth);
             let contact = Contact { normal: Vec3::Y, depth, overlapping_at_start };
-            contact.push_particle(&mut start[j], &mut p[j], sweep, local, moved, input.friction);
+            *drift += contact.push_particle(&mut start[j], &mut p[j], sweep, local, moved, input.friction);
         }
     }
     ContactPass { tested: p.len() as u64 - 1, touching, deepest }
@@ -137,6 +189,7 @@ fn collide_inside(
     p: &mut [DVec3],
     sweep: &ColliderSweep,
     input: &ContactInput<'_>,
+    drift: &mut f64,
 ) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
@@ -155,7 +208,7 @@ fn collide_inside(
             let depth = distance - limit;
             deepest = deepest.max(depth);
             let contact = Contact { normal: -offset / distance, depth, overlapping_at_start };
-            contact.push_particle(&mut start[j], &mut p[j], sweep, local, moved, input.friction);
+            *drift += contact.push_particle(&mut start[j], &mut p[j], sweep, local, moved, input.friction);
         }
     }
     ContactPass { tested: p.len() as u64 - 1, touching, deepest }
@@ -166,6 +219,8 @@ fn collide_outside(
     p: &mut [DVec3],
     sweep: &ColliderSweep,
     input: &ContactInput<'_>,
+    bounds: &[(DVec3, f64)],
+    drift: &mut f64,
 ) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
@@ -177,12 +232,9 @@ fn collide_outside(
     let centre = sweep.end.centre;
     let collider_travel = (sweep.end.centre - sweep.start.centre).length();
     let solid = (radius + half_height) as f64;
-    for k in 0..p.len() - 1 {
-        let half = (p[k + 1] - p[k]).length() * 0.5;
-        let travel = (p[k] - start[k]).length().max((p[k + 1] - start[k + 1]).length());
-        let thickness = input.radii[k].max(input.radii[k + 1]) as f64;
-        let clear = solid + thickness + half + travel + collider_travel;
-        if (p[k].midpoint(p[k + 1]) - centre).length_squared() > clear * clear {
+    for (k, &(midpoint, segment_reach)) in bounds.iter().enumerate() {
+        let clear = solid + segment_reach + collider_travel + 3.0 * *drift;
+        if (midpoint - centre).length_squared() > clear * clear {
             continue;
         }
         let (a, b) = (sweep.end.to_local(p[k]), sweep.end.to_local(p[k + 1]));
@@ -208,10 +260,12 @@ fn collide_outside(
         let world = sweep.end.direction_to_world(correction * scale);
         p[k] += world * wa as f64;
         p[k + 1] += world * wb as f64;
+        *drift += world.length() * (wa + wb) as f64;
         if overlapping_at_start {
             let push = sweep.end.direction_to_world(normal * (depth * scale));
             start[k] += push * wa as f64;
             start[k + 1] += push * wb as f64;
+            *drift += push.length() * (wa + wb) as f64;
         }
     }
     ContactPass { tested: p.len() as u64 - 1, touching, deepest }
@@ -262,7 +316,8 @@ impl Contact {
 
     /// Resolves the contact of one particle (`p` its position, `start` its position at the start of the
     /// substep, `local` and `moved` the same in the collider's frame); a particle already inside at the start
-    /// has its start moved out too (pre-stabilisation), so the push adds no velocity.
+    /// has its start moved out too (pre-stabilisation), so the push adds no velocity. Returns how far it moved
+    /// the two (for the quick reject's drift).
     fn push_particle(
         &self,
         start: &mut DVec3,
@@ -271,11 +326,16 @@ impl Contact {
         local: Vec3,
         moved: Vec3,
         coefficient: f32,
-    ) {
-        *p += sweep.end.direction_to_world(self.correction(local, moved, coefficient));
+    ) -> f64 {
+        let push = sweep.end.direction_to_world(self.correction(local, moved, coefficient));
+        *p += push;
+        let mut moved_by = push.length();
         if self.overlapping_at_start {
-            *start += sweep.end.direction_to_world(self.normal * self.depth);
+            let out = sweep.end.direction_to_world(self.normal * self.depth);
+            *start += out;
+            moved_by += out.length();
         }
+        moved_by
     }
 }
 
@@ -421,12 +481,37 @@ mod tests {
         let mut p = [DVec3::new(-1.0, 0.2, 0.0), DVec3::new(-0.5, 0.2, 0.0), DVec3::new(0.5, 0.2, 0.0)];
         let sweep = still(ColliderShape::Sphere { radius: 0.4 });
         let input = ContactInput { colliders: &[sweep], radii: &[0.0; 3], friction: 0.0, slop: 0.0 };
-        collide(&mut start, &mut p, &input);
+        collide(&mut start, &mut p, &input, &mut SegmentBounds::default());
         let (a, b) = (p[1].as_vec3(), p[2].as_vec3());
         let (t, _) = closest_between_segments((a, b), (Vec3::ZERO, Vec3::ZERO));
         let distance = a.lerp(b, t).length();
         assert!(distance >= 0.4 - 1e-5, "segment still inside: {distance}");
         assert_eq!(p[0], DVec3::new(-1.0, 0.2, 0.0), "the root never moves");
+    }
+
+    fn sphere_at(centre: DVec3, radius: f32) -> ColliderSweep {
+        let pose = ColliderPose { centre, rotation: Quat::IDENTITY };
+        ColliderSweep { shape: ColliderShape::Sphere { radius }, start: pose, end: pose }
+    }
+
+    #[test]
+    fn a_push_into_a_later_collider_is_caught_although_the_bounds_predate_it() {
+        // Sphere A pushes the short tip segment 3 cm down, into sphere B, which the segment cleared by 1 cm
+        // (beyond B's quick-reject reach) when the pass computed its bounds. One pass over [A, B] must do
+        // exactly what a pass over A then a pass over B (with fresh bounds) does.
+        let a = sphere_at(DVec3::new(1.02, 0.5, 0.0), 0.53);
+        let b = sphere_at(DVec3::new(1.01, -0.56, 0.0), 0.54);
+        let chain = [DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0), DVec3::new(1.02, 0.0, 0.0)];
+        let (both, only_a, only_b) = ([a, b], [a], [b]);
+        let input = |colliders| ContactInput { colliders, radii: &[0.0; 3], friction: 0.0, slop: 0.0 };
+        let (mut start, mut p) = (chain, chain);
+        let together = collide(&mut start, &mut p, &input(&both), &mut SegmentBounds::default());
+        let (mut start_apart, mut apart) = (chain, chain);
+        let first = collide(&mut start_apart, &mut apart, &input(&only_a), &mut SegmentBounds::default());
+        let second = collide(&mut start_apart, &mut apart, &input(&only_b), &mut SegmentBounds::default());
+        assert!(first.touching && second.touching, "the scene must need both pushes");
+        assert_eq!((p, start), (apart, start_apart));
+        assert_eq!(together.deepest, first.deepest.max(second.deepest));
     }
 
     #[test]
@@ -435,11 +520,21 @@ mod tests {
         let mut start = [DVec3::ZERO, DVec3::new(1.0, 0.0, 0.0)];
         // Pressed 0.1 into the plane while sliding 0.05 sideways: friction 1 holds it (0.05 < 1 * 0.1).
         let mut p = [DVec3::ZERO, DVec3::new(1.05, -0.1, 0.0)];
-        collide(&mut start, &mut p, &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0, slop: 0.0 });
+        collide(
+            &mut start,
+            &mut p,
+            &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0, slop: 0.0 },
+            &mut SegmentBounds::default(),
+        );
         assert!((p[1] - DVec3::new(1.0, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
         // Sliding 0.5: friction removes 0.1 of it.
         let mut p = [DVec3::ZERO, DVec3::new(1.5, -0.1, 0.0)];
-        collide(&mut start, &mut p, &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0, slop: 0.0 });
+        collide(
+            &mut start,
+            &mut p,
+            &ContactInput { colliders: &[plane], radii: &[0.0; 2], friction: 1.0, slop: 0.0 },
+            &mut SegmentBounds::default(),
+        );
         assert!((p[1] - DVec3::new(1.4, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
     }
 
@@ -448,7 +543,12 @@ mod tests {
         let sweep = still(ColliderShape::InsideSphere { radius: 1.0 });
         let mut start = [DVec3::ZERO, DVec3::new(0.5, 0.0, 0.0)];
         let mut p = [DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0)];
-        collide(&mut start, &mut p, &ContactInput { colliders: &[sweep], radii: &[0.1; 2], friction: 0.0, slop: 0.0 });
+        collide(
+            &mut start,
+            &mut p,
+            &ContactInput { colliders: &[sweep], radii: &[0.1; 2], friction: 0.0, slop: 0.0 },
+            &mut SegmentBounds::default(),
+        );
         assert!((p[1] - DVec3::new(0.9, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
     }
 }

@@ -4,7 +4,7 @@
 
 use glam::{DVec3, Mat3A, Quat, Vec3, Vec3A};
 
-use super::collision::{ContactInput, collide, pre_stabilise};
+use super::collision::{ContactInput, SegmentBounds, collide, pre_stabilise};
 use super::inextensible::{self, ConstraintScratch};
 use super::math::{Transform, align_hemisphere, exp_small, log_small, nlerp_shorter};
 use super::params::{ChainParams, EngineSettings};
@@ -145,6 +145,7 @@ pub struct RodScratch {
     /// Positions of the chain carried over to a new rest shape (momentum suppression).
     p_old: Vec<DVec3>,
     constraints: ConstraintScratch,
+    bounds: SegmentBounds,
 }
 
 impl RodScratch {
@@ -155,6 +156,7 @@ impl RodScratch {
             self.p_old.resize(n, DVec3::ZERO);
         }
         self.constraints.reserve(n.saturating_sub(1));
+        self.bounds.reserve(n.saturating_sub(1));
     }
 }
 
@@ -168,13 +170,13 @@ pub fn substep(
     let n = state.x.len();
     scratch.reserve(n);
     let h = input.h;
-    let RodScratch { p, qp, p_old, constraints } = scratch;
+    let RodScratch { p, qp, p_old, constraints, bounds } = scratch;
     let settled = input.contact_settled;
     if let Some(contacts) = &input.contacts {
         let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
             inextensible::solve(previous, x, lengths, constraints);
         };
-        pre_stabilise(&mut state.x, &mut p_old[..n], contacts, FINAL_CONTACT_ROUNDS, keep_lengths, settled);
+        pre_stabilise(&mut state.x, &mut p_old[..n], contacts, FINAL_CONTACT_ROUNDS, keep_lengths, settled, bounds);
     }
     // The start positions give the inextensibility solve its correction directions; only the contact pass
     // moves them (joints already inside a collider), and every solve after it is prepared again.
@@ -214,7 +216,7 @@ pub fn substep(
         }
         report.fallback |= !inextensible::solve_prepared(p, lengths, constraints);
         if let Some(contacts) = &input.contacts {
-            let mut pass = collide(&mut state.x, p, contacts);
+            let mut pass = collide(&mut state.x, p, contacts, bounds);
             inextensible::prepare(&state.x, lengths, constraints);
             report.contact_pairs += pass.tested;
             // A collider pushing hard (a swinging arm) moves a few particles far in one substep; the rest of
@@ -225,7 +227,7 @@ pub fn substep(
                         break;
                     }
                     report.fallback |= !inextensible::solve_prepared(p, lengths, constraints);
-                    pass = collide(&mut state.x, p, contacts);
+                    pass = collide(&mut state.x, p, contacts, bounds);
                     inextensible::prepare(&state.x, lengths, constraints);
                     report.contact_pairs += pass.tested;
                 }

@@ -48,7 +48,7 @@ impl LaneContacts {
 pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) {
     let n = g.n;
     for lane in (0..L).filter(|&lane| lanes.0[lane]) {
-        let LaneGroup { x, lengths, lane_x, lane_scratch, lane_lengths, contacts, constraints, .. } = g;
+        let LaneGroup { x, lengths, lane_x, lane_scratch, lane_lengths, contacts, constraints, segment_bounds, .. } = g;
         extract(&x[..n], lane, lane_x);
         lane_lengths.clear();
         lane_lengths.extend(lengths[..n - 1].iter().map(|l| l.0[lane]));
@@ -64,6 +64,7 @@ pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) {
             FINAL_CONTACT_ROUNDS,
             keep_lengths,
             contact.settled,
+            segment_bounds,
         );
         write_back(lane_x, lane, &mut x[..n]);
     }
@@ -75,11 +76,11 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> u64 {
     let n = g.n;
     let mut tested = 0;
     for lane in (0..L).filter(|&lane| lanes.0[lane]) {
-        let LaneGroup { x, p, lane_x, lane_p, contacts, .. } = g;
+        let LaneGroup { x, p, lane_x, lane_p, contacts, segment_bounds, .. } = g;
         extract(&x[..n], lane, lane_x);
         extract(&p[..n], lane, lane_p);
         let contact = &mut contacts[lane];
-        let pass = collision::collide(lane_x, lane_p, &contact.input());
+        let pass = collision::collide(lane_x, lane_p, &contact.input(), segment_bounds);
         contact.pass = Some(pass);
         tested += pass.tested;
         write_back(lane_x, lane, &mut x[..n]);

@@ -6,6 +6,7 @@ use glam::{DVec3, Quat, Vec3, Vec3A};
 use super::contacts::LaneContacts;
 use super::simd::{D, DV3, F, Mask, Q, V3};
 use crate::core::collider::ColliderSweep;
+use crate::core::collision::SegmentBounds;
 use crate::core::inextensible::ConstraintScratch;
 use crate::core::math::Transform;
 use crate::core::rod::{ChainConstants, RodState};
@@ -78,6 +79,7 @@ pub struct LaneGroup<const L: usize> {
     pub(super) lane_scratch: Vec<DVec3>,
     pub(super) lane_lengths: Vec<f32>,
     pub(super) constraints: ConstraintScratch,
+    pub(super) segment_bounds: SegmentBounds,
 }
 
 impl<const L: usize> Default for V3<L> {
@@ -142,6 +144,7 @@ impl<const L: usize> LaneGroup<L> {
         self.lane_p.reserve(n);
         self.lane_lengths.reserve(n);
         self.constraints.reserve(n);
+        self.segment_bounds.reserve(n);
     }
 
     /// Loads one chain into `lane`.

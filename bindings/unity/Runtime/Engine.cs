@@ -55,6 +55,11 @@ namespace Kodawari.Unity
                  + "below 1). Scripts set LOD by the character's distance to the camera.")]
         [Range(0, 3)] public int lod = 0;
 
+        [Tooltip("Lanes: chains of equal joint count stepped side by side in SIMD lanes (fastest). Lanes Portable: the "
+                 + "same bits without AVX2. Scalar: one chain at a time, the reference solver; differs from Lanes by float "
+                 + "rounding only.")]
+        public Solver solver = Solver.Lanes;
+
         [Header("Colliders")]
         [Tooltip("Colliders on the character's bones (head, shoulders, body) that keep the chains out.")]
         public List<BoneCollider> colliders = new List<BoneCollider>();
@@ -246,6 +251,7 @@ namespace Kodawari.Unity
             }
 
             native = new Kodawari.Engine(CreateDef());
+            native.Solver = solver;
             appliedLod = Mathf.Clamp(lod, 0, 3);
             var jointList = new List<Transform>();
             var anchorList = new List<Transform>();
@@ -387,6 +393,7 @@ namespace Kodawari.Unity
             {
                 settingsChanged = false;
                 native.Def = CreateDef();
+                native.Solver = solver;
                 appliedLod = Mathf.Clamp(lod, 0, 3);
                 // Sizes edited in the inspector: re-upload every collider's size at its bone's current scale.
                 for (int i = 0; i < colliderScales.Count; i++) ResizeCollider(i, activeColliders[i].bone.lossyScale);

@@ -5,16 +5,16 @@
 //! by the dynamic joints and substeps printed. Scenes: `100x16`, `1000x16`, `1x1000` (0.8 m rope), `1x1000_hair`
 //! (2.5 cm segments); variants: `lanes` (default), `scalar`, `colliders`
 //! (the head sphere, shoulders and ground of the report's colliders variant, on the lane solver) and
-//! `colliders_scalar`.
+//! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair).
 
 #[path = "../benches/support/scenes.rs"]
 mod scenes;
 
-use scenes::{COLLIDERS, COLLIDERS_SCALAR, PLAIN, PLAIN_SCALAR, ReadBack, Scene, SceneRun};
+use scenes::{ASLEEP, AWAKE_AT_REST, COLLIDERS, COLLIDERS_SCALAR, PLAIN, PLAIN_SCALAR, ReadBack, Scene, SceneRun};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar|colliders|colliders_scalar]";
+    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest]";
     let frames: u64 = args.first().and_then(|f| f.parse().ok()).expect(usage);
     let scene = match args.get(1).map(String::as_str) {
         Some("100x16") => Scene::uniform("100x16", 100, 16),
@@ -27,9 +27,15 @@ fn main() {
         Some("scalar") => PLAIN_SCALAR,
         Some("colliders") => COLLIDERS,
         Some("colliders_scalar") => COLLIDERS_SCALAR,
+        Some("asleep") => ASLEEP,
+        Some("awake_at_rest") => AWAKE_AT_REST,
         _ => PLAIN,
     };
     let mut run = SceneRun::new(&scene, variant, ReadBack::World).expect("the scene builds");
+    // `asleep`: the frames until every chain sleeps come first (subtract a run of 0 frames).
+    if let Some(note) = run.settle() {
+        println!("{note}");
+    }
     for _ in 0..frames {
         run.frame();
     }

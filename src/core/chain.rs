@@ -74,6 +74,11 @@ pub struct Chain {
     pub(crate) resume_from: Option<Transform>,
     /// Sleeping: nothing moved for a while; the chain is skipped until something changes.
     pub(crate) asleep: bool,
+    /// While asleep: the world pose under the anchor it fell asleep under, `asleep_anchor` (the output is
+    /// frozen, so while the anchor stays there the host's read-back copies it instead of transforming every
+    /// joint again; capacity reserved at creation).
+    asleep_world: Vec<Transform>,
+    asleep_anchor: Transform,
     /// Simulated seconds the chain has been still (towards falling asleep).
     pub(crate) still_time: f32,
 }
@@ -118,6 +123,8 @@ impl Chain {
             enabled: true,
             resume_from: None,
             asleep: false,
+            asleep_world: Vec::with_capacity(n),
+            asleep_anchor: Transform::IDENTITY,
             still_time: 0.0,
         };
         chain.update_rest(None);
@@ -194,6 +201,19 @@ impl Chain {
         self.state.w.fill(Vec3::ZERO);
         self.local_previous.clone_from(&self.local_current);
         self.write_output(1.0);
+        let anchor = self.anchor;
+        self.asleep_anchor = anchor;
+        self.asleep_world.clear();
+        self.asleep_world.extend(self.output.iter().map(|local| anchor.mul(local)));
+    }
+
+    /// Calls `f` with each joint's world transform (the anchor times the output pose).
+    pub(crate) fn for_each_world_transform(&self, mut f: impl FnMut(Transform)) {
+        if self.asleep && self.anchor == self.asleep_anchor {
+            self.asleep_world.iter().for_each(|world| f(*world));
+        } else {
+            self.output.iter().for_each(|local| f(self.anchor.mul(local)));
+        }
     }
 
     /// Replaces the base shape (same joint count). View shapes keep their bends and take the new lengths.
@@ -372,4 +392,34 @@ fn bone_axes(shape: &Shape) -> Vec<Vec3> {
 #[inline]
 pub(crate) fn relative_rotation(parent: Quat, q: Quat) -> Quat {
     (parent.inverse() * q).normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Quat, Vec3};
+
+    use super::*;
+
+    fn collect(chain: &Chain) -> Vec<Transform> {
+        let mut out = Vec::new();
+        chain.for_each_world_transform(|t| out.push(t));
+        out
+    }
+
+    #[test]
+    fn a_sleeping_chains_world_pose_is_its_output_under_the_current_anchor() {
+        let joints: Vec<Transform> =
+            (0..5).map(|i| Transform::new(Vec3::new(0.0, -0.05 * i as f32, 0.01 * i as f32), Quat::IDENTITY)).collect();
+        let mut chain = Chain::new(ChainParams::default(), &joints).unwrap();
+        chain.anchor = Transform::new(Vec3::new(0.3, 1.6, -0.2), Quat::from_rotation_y(0.7));
+        let under = |chain: &Chain, anchor: &Transform| chain.output.iter().map(|l| anchor.mul(l)).collect::<Vec<_>>();
+        chain.fall_asleep();
+        assert_eq!(collect(&chain), under(&chain, &chain.anchor), "asleep: the stored pose");
+        // An anchor that changed without the chain waking (e.g. by rounding of the engine-relative anchor).
+        let moved = Transform::new(Vec3::new(0.3, 1.6, -0.2 + 1e-6), Quat::from_rotation_y(0.7));
+        chain.anchor = moved;
+        assert_eq!(collect(&chain), under(&chain, &moved), "asleep under a moved anchor");
+        chain.wake();
+        assert_eq!(collect(&chain), under(&chain, &moved), "awake");
+    }
 }

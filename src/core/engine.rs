@@ -815,9 +815,7 @@ impl Engine {
     pub fn for_each_world_transform(&self, capacity: usize, mut f: impl FnMut(Transform)) -> Result<()> {
         self.check_capacity(capacity)?;
         for chain in self.chains_in_order() {
-            for local in &chain.output {
-                f(chain.anchor.mul(local));
-            }
+            chain.for_each_world_transform(&mut f);
         }
         Ok(())
     }
@@ -848,15 +846,10 @@ impl Engine {
 
     /// Calls `f` with the world transform of each joint of one chain; fails without calling it when
     /// `capacity` is below the chain's joint count.
-    pub fn for_each_chain_world_transform(
-        &self,
-        id: ChainId,
-        capacity: usize,
-        mut f: impl FnMut(Transform),
-    ) -> Result<()> {
+    pub fn for_each_chain_world_transform(&self, id: ChainId, capacity: usize, f: impl FnMut(Transform)) -> Result<()> {
         let chain = self.chain(id)?;
         check_chain_capacity(chain, capacity)?;
-        chain.output.iter().for_each(|local| f(chain.anchor.mul(local)));
+        chain.for_each_world_transform(f);
         Ok(())
     }
 

@@ -49,8 +49,8 @@ static ALLOCATOR: CountingAllocator = CountingAllocator;
 /// The solver path that ran: the lane solver (the default) with the kernel `kodawari::simd_path` reports for
 /// this CPU (contacts scalar, lane by lane), and the scalar solver for the few left over from the lane groups.
 fn solver_path() -> String {
-    const NEAR_COLLIDERS: &str = "contacts lane by lane in scalar code; the last 1-3 chains of a joint count (too \
-                                  few for a group): scalar solver";
+    const NEAR_COLLIDERS: &str = "contacts lane by lane in scalar code; the last 1 or 2 chains of a joint count after \
+                                  its groups of 8 (too few for a group): scalar solver";
     let lanes = "lane solver (chains of equal joint count in SIMD groups of 8 or 4)";
     match kodawari::simd_path() {
         "avx2" => format!("{lanes}, avx2 kernel chosen at run time; {NEAR_COLLIDERS}"),

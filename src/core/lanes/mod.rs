@@ -2,9 +2,10 @@
 //!
 //! Most chains of a character are alike (a head of hair: dozens of strands of one length), and the scalar
 //! solver leaves most of a modern CPU's vector width unused. Here a step sorts the chains it simulates by
-//! joint count (and limp or not), cuts each run of equal length into groups of 8 and 4 chains (so no lane is
-//! ever padding), and advances each group through all of the step's substeps in structure-of-arrays
-//! buffers. The last 1 to 3 chains of a run, too few for a group, take the scalar solver.
+//! joint count (and limp or not), cuts each run of equal length into groups of 8 and 4 chains (the last group
+//! of a run may repeat one of its chains in its spare lanes), and advances each group through all of the
+//! step's substeps in structure-of-arrays buffers. The last 1 or 2 chains of a run after its groups of 8,
+//! too few for a group to pay, take the scalar solver.
 //!
 //! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group; [`group`]: the buffers.
 //! - The wide copies of the kernel are compiled for AVX2 next to the portable (SSE2) one and chosen at run
@@ -47,7 +48,7 @@ pub enum Solver {
     /// [`Lanes`](Self::Lanes) with the portable copy of its kernel (SSE2 on x86-64) whatever the CPU has: the
     /// same bits, slower. For checking the determinism policy on one machine.
     LanesPortable,
-    /// One chain at a time: the reference implementation (and what the last 1-3 chains of a joint count use).
+    /// One chain at a time: the reference implementation (and what the last 1 or 2 chains of a joint count after its groups of 8 use).
     Scalar,
 }
 
@@ -103,15 +104,27 @@ pub struct LaneSolver {
     g4: LaneGroup<4>,
 }
 
-/// The narrowest lane group. Fewer chains of a kind than this run faster on the scalar solver, whose glam
-/// types use SIMD within a vector: a lane kernel one or two chains wide measured 1.5x slower than it.
-const NARROWEST: usize = 4;
+/// How a run of `len` chains of one kind is cut into lane groups: full groups of 8, then the rest as one
+/// group of 8 or 4 whose spare lanes repeat a chain of the group (computed, never stored), or on the scalar
+/// solver. Measured in instructions (callgrind, `step_cost 4 16 100 sway` on both solvers and `8 16 100`): a
+/// group of 4 costs 2.0x less than 4 chains on the scalar solver and a group of 8 1.4x as much as a group of
+/// 4, so 5-7 chains are cheapest as a padded group of 8, 3 as a padded group of 4, and 1-2 on the scalar
+/// solver (a group of 4 holding 2 costs what they cost there).
+fn group_widths(len: usize) -> impl Iterator<Item = (usize, usize)> {
+    let full = len / 8;
+    let tail = match len % 8 {
+        rest @ 5..=7 => Some((rest, 8)),
+        rest @ 3..=4 => Some((rest, 4)),
+        _ => None,
+    };
+    std::iter::repeat_n((8, 8), full).chain(tail)
+}
 
 impl LaneSolver {
-    /// Runs every substep of the step for the chains of `jobs` (reordered by joint count) that fill lane
-    /// groups, and moves the others (fewer than [`NARROWEST`] of a kind) to `leftovers` for the scalar solver.
-    /// Returns the substeps, summed over the chains, in which the direct inextensibility solve fell back, and
-    /// the contact pairs tested.
+    /// Runs every substep of the step for the chains of `jobs` (reordered by joint count) that go into lane
+    /// groups ([`group_widths`]), and moves the others to `leftovers` for the scalar solver. Returns the
+    /// substeps, summed over the chains, in which the direct inextensibility solve fell back, and the contact
+    /// pairs tested.
     pub(crate) fn step(
         &mut self,
         chains: &mut Arena<Chain>,
@@ -128,10 +141,9 @@ impl LaneSolver {
         while first < jobs.len() {
             let key = jobs[first].key();
             let len = jobs[first..].iter().take_while(|j| j.key() == key).count();
-            // Full groups of the narrowest width stay; the run's tail goes to the scalar solver.
-            let full = len / NARROWEST * NARROWEST;
+            let grouped: usize = group_widths(len).map(|(chains, _)| chains).sum();
             for i in first..first + len {
-                if i - first < full {
+                if i - first < grouped {
                     jobs[kept] = jobs[i];
                     kept += 1;
                 } else {
@@ -147,10 +159,10 @@ impl LaneSolver {
             let same = rest.iter().take_while(|j| j.key() == first.key()).count();
             let (mut run, tail) = rest.split_at(same);
             rest = tail;
-            while !run.is_empty() {
-                let (group, remaining) = run.split_at(if run.len() >= 8 { 8 } else { 4 });
+            for (count, width) in group_widths(same) {
+                let (group, remaining) = run.split_at(count);
                 run = remaining;
-                let (group_fallbacks, group_pairs) = match (group.len(), portable) {
+                let (group_fallbacks, group_pairs) = match (width, portable) {
                     (8, false) => run_group(&mut self.g8, chains, group, clock, reach, &WIDE8),
                     (8, true) => run_group(&mut self.g8, chains, group, clock, reach, &Phases::PORTABLE),
                     (_, false) => run_group(&mut self.g4, chains, group, clock, reach, &WIDE4),
@@ -231,6 +243,8 @@ macro_rules! wide_phases {
 wide_phases!(WIDE8, 8, begin8, match_shape8, polar8, solve_lengths8, PASSES8, first_pass8, corrected_pass8, finish8);
 wide_phases!(WIDE4, 4, begin4, match_shape4, polar4, solve_lengths4, PASSES4, first_pass4, corrected_pass4, finish4);
 
+/// Steps the chains of `jobs` (at most `L`) in `g`. Spare lanes repeat the first chain without its contacts;
+/// they are computed like any lane (lanes never affect each other) but not stored or counted.
 fn run_group<const L: usize>(
     g: &mut LaneGroup<L>,
     chains: &mut Arena<Chain>,
@@ -239,7 +253,7 @@ fn run_group<const L: usize>(
     reach: &Reach<'_>,
     phases: &Phases<L>,
 ) -> (u64, u64) {
-    debug_assert_eq!(jobs.len(), L);
+    debug_assert!(!jobs.is_empty() && jobs.len() <= L);
     let substeps = clock.progress.len();
     let first = &jobs[0];
     g.begin(GroupSettings {
@@ -250,7 +264,9 @@ fn run_group<const L: usize>(
         substeps,
     });
     let anchor = |job: &LaneJob, s: usize| job.start.interpolate(&job.target, clock.progress[s]);
-    for (lane, job) in jobs.iter().enumerate() {
+    for lane in 0..L {
+        let real = lane < jobs.len();
+        let job = if real { &jobs[lane] } else { first };
         let chain = chains.at(job.slot as usize).expect("live");
         g.load(
             lane,
@@ -269,7 +285,11 @@ fn run_group<const L: usize>(
         g.load_contacts(
             lane,
             reach.order.len(),
-            |candidates, radii| reach.candidates(chain, &job.start, &job.target, candidates, radii),
+            |candidates, radii| {
+                if real {
+                    reach.candidates(chain, &job.start, &job.target, candidates, radii)
+                }
+            },
             chain.params.friction,
             chain.contact_slop(),
             chain.contact_settled(),
@@ -286,7 +306,7 @@ fn run_group<const L: usize>(
         } else {
             kernel::substep(g, s, phases)
         };
-        fallbacks += fell_back.0.iter().filter(|&&f| f).count() as u64;
+        fallbacks += fell_back.0[..jobs.len()].iter().filter(|&&f| f).count() as u64;
         // The render interpolation keeps the last two internal poses.
         if s + 2 >= substeps {
             for (lane, job) in jobs.iter().enumerate() {

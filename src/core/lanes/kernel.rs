@@ -4,11 +4,10 @@
 //! solver branches on a value (convergence, a rotation too large for a series, a failed direct solve), the
 //! lanes keep a mask, and the rare lanes that need the scalar code get it one by one.
 
-use glam::{Quat, Vec3};
-
 use super::contacts;
 use super::group::LaneGroup;
 use super::lengths::{Passes, solve_lengths};
+use super::rotations::{Predict, Spin, angular_velocities, predict_orientations};
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
 use crate::core::inextensible;
 use crate::core::rod::FINAL_CONTACT_ROUNDS;
@@ -27,10 +26,10 @@ pub struct Phases<const L: usize> {
 impl<const L: usize> Phases<L> {
     /// The phases compiled for the baseline instruction set.
     pub const PORTABLE: Self = Self {
-        begin: begin_substep,
+        begin: |g, s| begin_substep(g, s, predict_orientations),
         match_shape: |g| match_shape(g, super::polar::extract_rotation),
         solve_lengths: |g, lanes| solve_lengths(g, lanes, &Passes::PORTABLE),
-        finish: finish_substep,
+        finish: |g| finish_substep(g, angular_velocities),
     };
 }
 
@@ -98,7 +97,7 @@ fn start_bonds<const L: usize>(g: &mut LaneGroup<L>) {
 
 /// Correction directions, the kinematic root, and the prediction of the dynamic particles.
 #[inline(always)]
-pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) {
+pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, predict: Predict<L>) {
     let n = g.n;
     let h = g.h;
     let (anchor_position, anchor_rotation) = g.anchors[s];
@@ -117,8 +116,8 @@ pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize) {
         g.v[i] = root_velocity + relative.scale(g.decay) + g.gravity.scale(kick);
         g.w[i] = g.w[i].scale(g.decay);
         g.p[i] = g.x[i] + (g.v[i] * h).to_f64();
-        g.qp[i] = exp_small(g.w[i] * h).mul(g.q[i]).normalize();
     }
+    predict(&g.w[1..n], &g.q[1..n], &mut g.qp[1..n], h);
 }
 
 /// One solver iteration: shape matching, then the lengths on every lane. Returns the lanes that fell back.
@@ -136,12 +135,12 @@ fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>) -> Mask<L> 
 
 /// Velocities from positions; the end of the substep becomes the start of the next.
 #[inline(always)]
-pub fn finish_substep<const L: usize>(g: &mut LaneGroup<L>) {
+pub fn finish_substep<const L: usize>(g: &mut LaneGroup<L>, spin: Spin<L>) {
     let n = g.n;
     let inv_h = 1.0 / g.h;
+    spin(&g.qp[1..n], &g.q[1..n], &mut g.w[1..n], inv_h);
     for i in 1..n {
         g.v[i] = (g.p[i] - g.x[i]).to_f32() * inv_h;
-        g.w[i] = log_small(g.qp[i].mul(g.q[i].conjugate()).align_hemisphere(Q::IDENTITY)) * inv_h;
         g.x[i] = g.p[i];
         g.q[i] = g.qp[i];
     }
@@ -215,49 +214,6 @@ fn orientation_term<const L: usize>(g: &LaneGroup<L>, j: usize, weight: F<L>) ->
 fn pull_to_goal<const L: usize>(p: DV3<L>, centre: DV3<L>, offset: V3<L>, alpha: D<L>) -> DV3<L> {
     let goal = centre + offset.to_f64();
     p + (goal - p).scale(alpha)
-}
-
-/// `math::exp_small` on every lane: the series where the turn is short, `Quat::from_scaled_axis` per lane
-/// elsewhere (rare: more than a radian in one substep or solver step).
-#[inline(always)]
-fn exp_small<const L: usize>(e: V3<L>) -> Q<L> {
-    let x2 = e.length_squared() * 0.25;
-    let cos = x2 * (x2 * (x2 * (x2 * (1.0 / 40320.0) + -1.0 / 720.0) + 1.0 / 24.0) + -1.0 / 2.0) + 1.0;
-    let sinc = x2 * (x2 * (x2 * (x2 * (1.0 / 362880.0) + -1.0 / 5040.0) + 1.0 / 120.0) + -1.0 / 6.0) + 1.0;
-    let v = e.scale(sinc * 0.5);
-    let mut q = Q { x: v.x, y: v.y, z: v.z, w: cos };
-    let far = x2.gt(F::splat(0.25));
-    if far.any() {
-        for lane in 0..L {
-            if far.0[lane] {
-                q.set(lane, Quat::from_scaled_axis(Vec3::from_array(e.get(lane))).to_array());
-            }
-        }
-    }
-    q
-}
-
-/// `math::log_small` on every lane, with `Quat::to_scaled_axis` per lane where the series does not apply.
-#[inline(always)]
-fn log_small<const L: usize>(q: Q<L>) -> V3<L> {
-    let v = q.xyz();
-    let s2 = v.length_squared();
-    let inv_w = F::splat(1.0) / q.w;
-    let t2 = s2 * inv_w * inv_w;
-    let atan_t_over_t = t2 * (t2 * (t2 * (t2 * (1.0 / 9.0) + -1.0 / 7.0) + 1.0 / 5.0) + -1.0 / 3.0) + 1.0;
-    let series = v.scale(inv_w * 2.0 * atan_t_over_t);
-    let in_range = q.w.gt(F::splat(0.0)).and(s2.le(q.w * q.w * 0.04)).and(s2.ge(F::splat(1e-16)));
-    let mut r = V3::select(in_range, series, V3::ZERO);
-    let tiny = s2.lt(F::splat(1e-16));
-    let exact = in_range.or(tiny).not();
-    if exact.any() {
-        for lane in 0..L {
-            if exact.0[lane] {
-                r.set(lane, Quat::from_array(q.get(lane)).to_scaled_axis().to_array());
-            }
-        }
-    }
-    r
 }
 
 /// The scalar fallback for every lane not in `solved` (or not to be solved), one lane at a time.

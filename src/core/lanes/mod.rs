@@ -25,6 +25,8 @@ mod group;
 mod kernel;
 mod lengths;
 mod polar;
+mod rotations;
+mod scalar;
 mod simd;
 
 use multiversion::multiversion;
@@ -37,7 +39,7 @@ use super::rod::ChainConstants;
 use group::{GroupSettings, LaneChain, LaneGroup};
 use kernel::Phases;
 use lengths::{ForwardPass, Passes};
-use simd::{D, DV3, M3, Mask, Q};
+use simd::{D, DV3, M3, Mask, Q, V3};
 
 /// Which solver steps the chains.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -178,10 +180,20 @@ impl LaneSolver {
 
 /// The kernel's phases compiled with AVX2 where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident) => {
+    ($name:ident, $lanes:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident) => {
         #[multiversion(targets("x86_64+avx2"))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
-            kernel::begin_substep(g, s)
+            kernel::begin_substep(g, s, $predict)
+        }
+
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $predict(w: &[V3<$lanes>], q: &[Q<$lanes>], qp: &mut [Q<$lanes>], h: f32) {
+            rotations::predict_orientations(w, q, qp, h)
+        }
+
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $spin(qp: &[Q<$lanes>], q: &[Q<$lanes>], w: &mut [V3<$lanes>], inv_h: f32) {
+            rotations::angular_velocities(qp, q, w, inv_h)
         }
 
         #[multiversion(targets("x86_64+avx2"))]
@@ -232,7 +244,7 @@ macro_rules! wide_phases {
 
         #[multiversion(targets("x86_64+avx2"))]
         fn $finish(g: &mut LaneGroup<$lanes>) {
-            kernel::finish_substep(g)
+            kernel::finish_substep(g, $spin)
         }
 
         const $name: Phases<$lanes> =
@@ -240,8 +252,34 @@ macro_rules! wide_phases {
     };
 }
 
-wide_phases!(WIDE8, 8, begin8, match_shape8, polar8, solve_lengths8, PASSES8, first_pass8, corrected_pass8, finish8);
-wide_phases!(WIDE4, 4, begin4, match_shape4, polar4, solve_lengths4, PASSES4, first_pass4, corrected_pass4, finish4);
+wide_phases!(
+    WIDE8,
+    8,
+    begin8,
+    match_shape8,
+    polar8,
+    solve_lengths8,
+    PASSES8,
+    first_pass8,
+    corrected_pass8,
+    finish8,
+    predict8,
+    spin8
+);
+wide_phases!(
+    WIDE4,
+    4,
+    begin4,
+    match_shape4,
+    polar4,
+    solve_lengths4,
+    PASSES4,
+    first_pass4,
+    corrected_pass4,
+    finish4,
+    predict4,
+    spin4
+);
 
 /// Steps the chains of `jobs` (at most `L`) in `g`. Spare lanes repeat the first chain without its contacts;
 /// they are computed like any lane (lanes never affect each other) but not stored or counted.

@@ -11,15 +11,13 @@
 
 use glam::{Quat, Vec3};
 
+use super::scalar::{Quaternion, Vec, exp_series, length_squared, mul};
 use super::simd::{F, M3, Mask, Q, V3};
 use crate::core::polar::{CONVERGED_ANGLE, MAX_NEWTON_ANGLE, MIN_PIVOT};
 use crate::core::rod::POLAR_ITERATIONS;
 
-type Vec = [f32; 3];
 /// Columns.
 type Mat = [Vec; 3];
-/// `x, y, z, w`.
-type Quaternion = [f32; 4];
 
 /// Improves every lane's `q` towards the rotation part of its `a`; a lane stops changing once it has
 /// converged. Returns the rotation matrices of the final `q`.
@@ -106,21 +104,6 @@ fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec) -> Vec {
     if definite & short { step } else { muller }
 }
 
-/// `math::exp_small`'s series, and whether the turn is too long for it.
-#[inline(always)]
-fn exp_series(e: Vec) -> (Quaternion, bool) {
-    let x2 = length_squared(e) * 0.25;
-    let cos = x2 * (x2 * (x2 * (x2 * (1.0 / 40320.0) + -1.0 / 720.0) + 1.0 / 24.0) + -1.0 / 2.0) + 1.0;
-    let sinc = x2 * (x2 * (x2 * (x2 * (1.0 / 362880.0) + -1.0 / 5040.0) + 1.0 / 120.0) + -1.0 / 6.0) + 1.0;
-    let half = sinc * 0.5;
-    ([e[0] * half, e[1] * half, e[2] * half, cos], x2 > 0.25)
-}
-
-#[inline(always)]
-fn length_squared(v: Vec) -> f32 {
-    v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
-}
-
 /// `M3::from_quat`.
 #[inline(always)]
 fn from_quat([x, y, z, w]: Quaternion) -> Mat {
@@ -136,15 +119,4 @@ fn from_quat([x, y, z, w]: Quaternion) -> Mat {
 fn transpose_mul(r: &Mat, v: Vec) -> Vec {
     let dot = |c: Vec| c[0] * v[0] + c[1] * v[1] + c[2] * v[2];
     [dot(r[0]), dot(r[1]), dot(r[2])]
-}
-
-/// `Q::mul`: the Hamilton product `a * b`.
-#[inline(always)]
-fn mul([ax, ay, az, aw]: Quaternion, [bx, by, bz, bw]: Quaternion) -> Quaternion {
-    [
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    ]
 }

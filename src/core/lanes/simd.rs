@@ -369,12 +369,6 @@ impl<const L: usize> Q<L> {
         self.x * o.x + self.y * o.y + self.z * o.z + self.w * o.w
     }
 
-    /// The inverse of a unit quaternion.
-    #[inline(always)]
-    pub fn conjugate(self) -> Self {
-        Self { x: -self.x, y: -self.y, z: -self.z, w: self.w }
-    }
-
     /// The Hamilton product `self * o` (apply `o` first).
     #[inline(always)]
     pub fn mul(self, o: Self) -> Self {

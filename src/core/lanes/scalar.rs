@@ -1,0 +1,66 @@
+//! One lane's arithmetic, for the kernel parts written as loops over lanes ([`polar`](super::polar),
+//! [`rotations`](super::rotations)): the lane types' operations (`simd`) on plain arrays, operation for
+//! operation and in the same order, so a lane loop computes the bits the array operations would.
+
+/// A 3-vector.
+pub type Vec = [f32; 3];
+/// A quaternion, `x, y, z, w`.
+pub type Quaternion = [f32; 4];
+
+#[inline(always)]
+pub fn length_squared(v: Vec) -> f32 {
+    v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+}
+
+#[inline(always)]
+pub fn scale(v: Vec, s: f32) -> Vec {
+    [v[0] * s, v[1] * s, v[2] * s]
+}
+
+#[inline(always)]
+pub fn dot4(a: Quaternion, b: Quaternion) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
+}
+
+/// `Q::mul`: the Hamilton product `a * b`.
+#[inline(always)]
+pub fn mul([ax, ay, az, aw]: Quaternion, [bx, by, bz, bw]: Quaternion) -> Quaternion {
+    [
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ]
+}
+
+/// `Q::normalize`.
+#[inline(always)]
+pub fn normalize(q: Quaternion) -> Quaternion {
+    let inv = 1.0 / dot4(q, q).sqrt();
+    [q[0] * inv, q[1] * inv, q[2] * inv, q[3] * inv]
+}
+
+/// `kernel::exp_small`'s series (`math::exp_small`), and whether the turn is too long for it.
+#[inline(always)]
+pub fn exp_series(e: Vec) -> (Quaternion, bool) {
+    let x2 = length_squared(e) * 0.25;
+    let cos = x2 * (x2 * (x2 * (x2 * (1.0 / 40320.0) + -1.0 / 720.0) + 1.0 / 24.0) + -1.0 / 2.0) + 1.0;
+    let sinc = x2 * (x2 * (x2 * (x2 * (1.0 / 362880.0) + -1.0 / 5040.0) + 1.0 / 120.0) + -1.0 / 6.0) + 1.0;
+    let half = sinc * 0.5;
+    ([e[0] * half, e[1] * half, e[2] * half, cos], x2 > 0.25)
+}
+
+/// `kernel::log_small`'s series (`math::log_small`), zero where it does not apply, and whether the exact
+/// logarithm is needed (outside the series' range and not below glam's threshold, where it returns zero).
+#[inline(always)]
+pub fn log_series(q: Quaternion) -> (Vec, bool) {
+    let v = [q[0], q[1], q[2]];
+    let s2 = length_squared(v);
+    let inv_w = 1.0 / q[3];
+    let t2 = s2 * inv_w * inv_w;
+    let atan_t_over_t = t2 * (t2 * (t2 * (t2 * (1.0 / 9.0) + -1.0 / 7.0) + 1.0 / 5.0) + -1.0 / 3.0) + 1.0;
+    let series = scale(v, inv_w * 2.0 * atan_t_over_t);
+    let in_range = (q[3] > 0.0) & (s2 <= q[3] * q[3] * 0.04) & (s2 >= 1e-16);
+    let tiny = s2 < 1e-16;
+    (if in_range { series } else { [0.0; 3] }, !(in_range | tiny))
+}

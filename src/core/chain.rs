@@ -209,7 +209,7 @@ impl Chain {
 
     /// Calls `f` with each joint's world transform (the anchor times the output pose).
     pub(crate) fn for_each_world_transform(&self, mut f: impl FnMut(Transform)) {
-        if self.asleep && self.anchor == self.asleep_anchor {
+        if self.asleep && same_bits(&self.anchor, &self.asleep_anchor) {
             self.asleep_world.iter().for_each(|world| f(*world));
         } else {
             self.output.iter().for_each(|local| f(self.anchor.mul(local)));
@@ -366,6 +366,13 @@ impl Chain {
     pub(crate) fn view_shape_index(&self, id: ViewShapeId) -> Option<usize> {
         self.views.iter().position(|v| v.id == id)
     }
+}
+
+/// The two transforms are the same to the bit (unlike `==`, which takes `-0.0` for `0.0`): a pose stored under
+/// one is the pose computed under the other.
+fn same_bits(a: &Transform, b: &Transform) -> bool {
+    let bits = |t: &Transform| (t.position.to_array().map(f32::to_bits), t.rotation.to_array().map(f32::to_bits));
+    bits(a) == bits(b)
 }
 
 /// Share of a chain's shortest segment a joint must have been inside a collider at the start of a substep to

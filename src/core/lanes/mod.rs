@@ -7,15 +7,18 @@
 //! step's substeps in structure-of-arrays buffers. The last 1 or 2 chains of a run after its groups of 8,
 //! too few for a group to pay, take the scalar solver.
 //!
-//! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group; [`group`]: the buffers.
+//! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group, whose phases are compiled one by one;
+//!   [`polar`], [`lengths`] and [`rotations`]: the parts written as loops over lanes, with one lane's
+//!   arithmetic in [`scalar`]; [`contacts`]: the contact pass, lane by lane; [`group`]: the buffers.
 //! - The wide copies of the kernel are compiled for AVX2 next to the portable (SSE2) one and chosen at run
 //!   time by CPU-feature detection ([`multiversion`]); no build needs `target-cpu=native`.
 //! - Determinism: a chain's result does not depend on its lane, on the group it shares (8 or 4 wide), or on
 //!   which copy of the kernel ran (no fused or reordered floating-point operations): the same bits on every
 //!   x86-64 and aarch64 CPU. It differs from the scalar solver ([`Solver::Scalar`]) by float rounding only
 //!   (the two implement the same operations, grouped differently); `tests/lanes.rs` and the accuracy report
-//!   measure by how much. So whether a chain runs in lanes (it has at least 3 siblings of its joint count in
-//!   the step) changes its motion by rounding, never more; the same inputs always give the same bits.
+//!   measure by how much. So whether a chain runs in lanes (every chain of a joint count does but the last 1
+//!   or 2 after its groups of 8) changes its motion by rounding, never more; the same inputs always give the
+//!   same bits.
 //! - Chains that may touch a collider run in lanes too: the contact pass stays scalar, one lane at a time,
 //!   between the vector phases of the substep ([`contacts`]); everything else a chain does (sleeping,
 //!   teleports, momentum suppression, output) is shared with the scalar solver.
@@ -50,7 +53,8 @@ pub enum Solver {
     /// [`Lanes`](Self::Lanes) with the portable copy of its kernel (SSE2 on x86-64) whatever the CPU has: the
     /// same bits, slower. For checking the determinism policy on one machine.
     LanesPortable,
-    /// One chain at a time: the reference implementation (and what the last 1 or 2 chains of a joint count after its groups of 8 use).
+    /// One chain at a time: the reference implementation (and what the last 1 or 2 chains of a joint count
+    /// after its groups of 8 use).
     Scalar,
 }
 

@@ -15,8 +15,9 @@ type DVec = [f64; 3];
 /// The two kinds of forward pass, as functions compiled for the instruction set at hand (`mod.rs`). They
 /// must stay real functions taking every buffer as a separate slice: only across such a call does the
 /// compiler know the buffers do not overlap, which it must to vectorise the lane loops (inlined, with the
-/// slices cut from the group's `Vec`s, the loops stayed scalar: measured with callgrind, 66 % scalar
-/// instructions).
+/// slices cut from the group's `Vec`s, the loops stayed scalar). As functions they run 70 % 256-bit
+/// instructions (`tools/instruction_mix.py corrected_pass8_avx2_version -- target/release/examples/step_cost
+/// 64 16 20 sway`).
 pub struct Passes<const L: usize> {
     pub first: FirstPass<L>,
     pub corrected: CorrectedPass<L>,

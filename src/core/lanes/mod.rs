@@ -113,8 +113,8 @@ pub struct LaneSolver {
 /// How a run of `len` chains of one kind is cut into lane groups: full groups of 8, then the rest as one
 /// group of 8 or 4 whose spare lanes repeat a chain of the group (computed, never stored), or on the scalar
 /// solver. Measured in instructions (callgrind, `step_cost 4 16 100 sway` on both solvers and `8 16 100`): a
-/// group of 4 costs 2.0x less than 4 chains on the scalar solver and a group of 8 1.4x as much as a group of
-/// 4, so 5-7 chains are cheapest as a padded group of 8, 3 as a padded group of 4, and 1-2 on the scalar
+/// group of 4 costs 2.0x less than 4 chains on the scalar solver (39.1M against 79.0M) and a group of 8 1.33x
+/// as much as a group of 4 (51.8M), so 5-7 chains are cheapest as a padded group of 8, 3 as a padded group of 4, and 1-2 on the scalar
 /// solver (a group of 4 holding 2 costs what they cost there).
 fn group_widths(len: usize) -> impl Iterator<Item = (usize, usize)> {
     let full = len / 8;

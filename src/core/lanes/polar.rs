@@ -1,8 +1,9 @@
 //! `polar::extract_rotation` on every lane of a group, its arithmetic written as a loop over the lanes whose
 //! body is one lane's scalar code. The compiler vectorises that loop to the full width; the same iteration
-//! written with 8-lane array operations (`simd`) was split into 4-lane halves and scalar pieces. Measured with
-//! callgrind on the AVX2 copy (`step_cost 64 16 20 sway`): 77 % 128-bit and 12 % scalar instructions before,
-//! 84 % 256-bit after, and 2.5x fewer instructions. The loop body must stay free of branches and conditional
+//! written with 8-lane array operations (`simd`) inside one function for the whole substep was split into
+//! 4-lane halves and scalar pieces. `tools/instruction_mix.py` on `step_cost 64 16 20 sway`: the kernel as one
+//! function (commit 77a1d8a) ran 62 % 128-bit, 11 % scalar and 17 % 256-bit instructions; this function runs
+//! 84 % 256-bit. The loop body must stay free of branches and conditional
 //! stores (either makes the compiler give up and run it lane by lane): the per-lane choices are `&` and
 //! selects, and the masked update of `q` is an array operation after the loop.
 //!
@@ -78,7 +79,8 @@ fn exact_turns<const L: usize>(q: &Q<L>, steps: &V3<L>, active: &[bool; L], next
     }
 }
 
-/// `polar::newton_step`, or the Müller step `muller` where the Newton step is not trusted.
+/// `polar::newton_step`, or the Müller step `muller` where the Newton step is not trusted. A mirror rather than
+/// a call: that one takes glam's SIMD `Mat3A` and returns an `Option`, and either keeps the lane loop scalar.
 #[inline(always)]
 fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec) -> Vec {
     let (h00, h11, h22) = (trace - s[0][0], trace - s[1][1], trace - s[2][2]);

@@ -5,7 +5,9 @@
 //! by the dynamic joints and substeps printed. Scenes: `100x16`, `1000x16`, `1x1000` (0.8 m rope), `1x1000_hair`
 //! (2.5 cm segments); variants: `lanes` (default), `scalar`, `colliders`
 //! (the head sphere, shoulders and ground of the report's colliders variant, on the lane solver) and
-//! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair).
+//! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair). It also prints the
+//! engine's state hash and the contact pairs tested, so that two builds can be checked to compute the same
+//! bits on a scene.
 
 #[path = "../benches/support/scenes.rs"]
 mod scenes;
@@ -40,6 +42,7 @@ fn main() {
         run.frame();
     }
     let stats = run.engine.stats();
+    println!("hash {:016x} pairs {}", run.engine.state_hash(), stats.contact_pairs_tested);
     println!(
         "{} ({}), {}: {} dynamic joints, {} substeps, {} solver fallbacks",
         scene.name,

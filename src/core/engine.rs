@@ -91,6 +91,7 @@ impl ScalarRun<'_> {
                 contacts: contacts.as_deref().filter(|_| touching).map(|contacts| ContactInput {
                     colliders: &contacts.chain_sweeps,
                     radii: &contacts.radii,
+                    lengths: &chain.frame.lengths,
                     friction: chain.params.friction,
                     slop,
                 }),

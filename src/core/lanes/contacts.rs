@@ -21,6 +21,8 @@ pub(crate) struct LaneContacts {
     pub sweeps: Vec<ColliderSweep>,
     /// Collision radius of each particle (m, scaled).
     pub radii: Vec<f32>,
+    /// Rest length of each segment (m), as the lengths solve keeps them.
+    pub lengths: Vec<f32>,
     pub friction: f32,
     /// `ContactInput::slop`.
     pub slop: f32,
@@ -32,7 +34,13 @@ pub(crate) struct LaneContacts {
 
 impl LaneContacts {
     fn input(&self) -> ContactInput<'_> {
-        ContactInput { colliders: &self.sweeps, radii: &self.radii, friction: self.friction, slop: self.slop }
+        ContactInput {
+            colliders: &self.sweeps,
+            radii: &self.radii,
+            lengths: &self.lengths,
+            friction: self.friction,
+            slop: self.slop,
+        }
     }
 
     /// The sweeps of substep `s`, from every collider's sweeps of the step (`[substep * colliders + c]`).

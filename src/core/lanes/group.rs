@@ -202,6 +202,10 @@ impl<const L: usize> LaneGroup<L> {
         contact.sweeps.clear();
         contact.sweeps.reserve(colliders);
         find(&mut contact.candidates, &mut contact.radii);
+        contact.lengths.clear();
+        if !contact.candidates.is_empty() {
+            contact.lengths.extend(self.lengths[..self.n - 1].iter().map(|l| l.0[lane]));
+        }
         contact.friction = friction;
         contact.slop = slop;
         contact.settled = settled;

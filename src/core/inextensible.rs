@@ -1,9 +1,12 @@
 //! Inextensibility: the chain's distance constraints solved together, the way molecular dynamics solves
 //! rigid bonds (SHAKE). Corrections act along the bond directions of the previous substep, which keeps the
 //! scheme symplectic and second order; the coupled system is tridiagonal, so a Newton iteration is one
-//! O(n) Thomas solve.
+//! O(n) Thomas solve. Where it fails (long or fine chains, bug 1 in docs/robustness.md), [`implicit`] solves
+//! the exact projection instead.
 
 use glam::DVec3;
+
+use super::implicit::{self, ImplicitScratch};
 
 /// Relative error of `|b|^2 / l^2 - 1` below which a bond counts as satisfied (about 5e-7 in length:
 /// the float32 floor).
@@ -14,6 +17,11 @@ pub(crate) const STAGNATION_LIMIT: f64 = 1e-3;
 const FALLBACK_SWEEPS: usize = 64;
 /// Iterations of the relinearized fallback (it converges in 3 to 6 where it converges at all).
 const RELINEARIZED_ITERATIONS: usize = 16;
+/// The relinearized fallback has lost its way once an iteration leaves its bonds off by more than their own
+/// squared length (`|b|^2 / l^2 - 1 > 1`) and this many times its start's error: on bug 1's fine ropes its
+/// first step overshoots by 8 to 500 times and it never recovers within its iterations, where on the hair
+/// ropes it converges on it stays within 4 times.
+const RELINEARIZED_LOST: f64 = 4.0;
 /// A pivot of the Newton system smaller than this share of its largest diagonal entry counts as vanishing.
 pub(crate) const MIN_PIVOT: f64 = 1e-7;
 
@@ -29,6 +37,7 @@ pub struct ConstraintScratch {
     length_squared: Vec<f64>,
     inverse_length_squared: Vec<f64>,
     newton: NewtonScratch,
+    implicit: ImplicitScratch,
 }
 
 #[derive(Default)]
@@ -58,6 +67,7 @@ impl ConstraintScratch {
         if corrected.len() < bonds + 1 {
             corrected.resize(bonds + 1, DVec3::ZERO);
         }
+        self.implicit.reserve(bonds);
     }
 }
 
@@ -100,8 +110,8 @@ pub fn solve_prepared(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratc
 }
 
 /// What [`solve_prepared`] does when the direct solve fails, for a solver that ran its own direct solve (the
-/// lane path): the Gauss-Newton projection along the current bonds, then Gauss-Seidel if even that fails.
-pub fn solve_fallback(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
+/// lane path), whose last multipliers are `multipliers`: see `fall_back`.
+pub fn solve_fallback(p: &mut [DVec3], lengths: &[f32], multipliers: &[f64], s: &mut ConstraintScratch) {
     let m = lengths.len();
     s.reserve(m);
     for k in 0..m {
@@ -109,16 +119,26 @@ pub fn solve_fallback(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratc
         s.length_squared[k] = l2;
         s.inverse_length_squared[k] = 1.0 / l2;
     }
+    s.newton.mu[..m].copy_from_slice(&multipliers[..m]);
     fall_back(p, lengths, s);
 }
 
+/// After a failed direct solve (its last multipliers in `s.newton.mu`): the Gauss-Newton projection along
+/// the current bonds, cheap where it converges (hair-length segments); if it fails, the exact projection
+/// (`implicit`), which converges on the fine ropes that defeat both (bug 1); if even that fails,
+/// Gauss-Seidel sweeps from the positions the fallback was given.
 fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
     let m = lengths.len();
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
+    // The Gauss-Newton projection moves `p` and overwrites the multipliers: keep both for the exact one.
+    s.implicit.begin(p, &s.newton.mu[..m]);
     for k in 0..m {
         s.current_bonds[k] = p[k + 1] - p[k];
     }
-    if !project_relinearized(p, &mut s.current_bonds[..m], l2, inv_l2, &mut s.newton) {
+    if project_relinearized(p, &mut s.current_bonds[..m], l2, inv_l2, &mut s.newton) {
+        return;
+    }
+    if !implicit::project(p, l2, inv_l2, TOLERANCE, &mut s.implicit) {
         project_gauss_seidel(p, lengths);
     }
 }
@@ -140,7 +160,8 @@ fn project_relinearized(
     let (l2, inv_l2) = (&length_squared[..m], &inverse_length_squared[..m]);
     let (mu, c_prime, d_prime) = (&mut s.mu[..m], &mut s.c_prime[..m], &mut s.d_prime[..m]);
     let mut previous_worst = f64::INFINITY;
-    for _ in 0..RELINEARIZED_ITERATIONS {
+    let mut lost = f64::INFINITY;
+    for iteration in 0..RELINEARIZED_ITERATIONS {
         for k in 0..m {
             d[k] = p[k + 1] - p[k];
         }
@@ -150,6 +171,11 @@ fn project_relinearized(
         }
         if pass.converged(previous_worst) {
             return true;
+        }
+        if iteration == 0 {
+            lost = (RELINEARIZED_LOST * pass.worst).max(1.0);
+        } else if pass.worst > lost {
+            return false;
         }
         previous_worst = pass.worst;
         if !pass.pivots_usable() || !back_substitute(c_prime, d_prime, mu, Update::Replace) {
@@ -382,6 +408,49 @@ mod tests {
         let mut s = ConstraintScratch::default();
         assert!(solve(&x, &mut p, &lengths, &mut s));
         assert!(max_stretch(&p, &lengths) < 1e-6, "{}", max_stretch(&p, &lengths));
+    }
+
+    /// A fine rope (400 joints of 1 mm in a gentle S) whose every joint the prediction moved by a few tenths of
+    /// a segment: the Gauss-Newton projection loses its way, the exact projection converges, and its answer is
+    /// nearer the prediction than the direct solve's (both keep the lengths; the projection is the nearest
+    /// such positions).
+    #[test]
+    fn fine_rope_projection_converges_where_gauss_newton_does_not() {
+        let n = 400;
+        let x: Vec<DVec3> = (0..n)
+            .map(|i| {
+                let s = i as f64 * 1e-3;
+                DVec3::new(0.02 * (s * 20.0).sin(), -s, 0.0)
+            })
+            .collect();
+        let lengths: Vec<f32> = x.windows(2).map(|w| (w[1] - w[0]).length() as f32).collect();
+        let predicted: Vec<DVec3> = x
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let i = i as f64;
+                if i == 0.0 { *v } else { *v + DVec3::new(2e-4 * (i * 0.05).sin(), -3e-4, 2e-4 * (i * 0.031).cos()) }
+            })
+            .collect();
+        let distance = |p: &[DVec3]| p.iter().zip(&predicted).map(|(a, b)| (*a - *b).length_squared()).sum::<f64>();
+        let mut s = ConstraintScratch::default();
+        let m = n - 1;
+        let mut direct = predicted.clone();
+        assert!(solve(&x, &mut direct, &lengths, &mut s));
+        let multipliers = s.newton.mu[..m].to_vec();
+
+        let mut relinearized = predicted.clone();
+        s.current_bonds[..m].copy_from_slice(&predicted.windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>());
+        let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
+        assert!(!project_relinearized(&mut relinearized, &mut s.current_bonds[..m], l2, inv_l2, &mut s.newton));
+
+        let mut projected = predicted.clone();
+        s.implicit.begin(&projected, &multipliers);
+        assert!(implicit::project(&mut projected, l2, inv_l2, TOLERANCE, &mut s.implicit));
+        assert!(max_stretch(&projected, &lengths) < 1e-6, "{}", max_stretch(&projected, &lengths));
+        assert_eq!(projected[0], x[0]);
+        let (nearest, other) = (distance(&projected), distance(&direct));
+        assert!(nearest < other, "projection moved the joints by {nearest:.3e} m^2, the direct solve by {other:.3e}");
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! - [`shape`]: shapes and their encoded form (SPEC 3.1)
 //! - [`weights`]: view direction and blend weights (3.2)
 //! - [`blend`]: blending encoded shapes (3.3)
-//! - [`polar`], [`rod`], [`inextensible`]: the oriented-particle rod and its constraints (3.4)
+//! - [`polar`], [`rod`], [`inextensible`], [`implicit`]: the oriented-particle rod and its constraints (3.4)
 //! - [`lanes`]: the same rod, chains of equal length side by side in SIMD lanes
 //! - [`collider`], [`collision`]: colliders and the contact pass (3.7)
 //! - [`batch`]: many engines in one call (optionally on a thread pool)
@@ -19,6 +19,7 @@ pub mod collider;
 pub mod collision;
 pub mod engine;
 pub mod error;
+pub mod implicit;
 pub mod inextensible;
 pub mod lanes;
 pub mod math;

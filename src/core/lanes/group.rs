@@ -78,6 +78,8 @@ pub struct LaneGroup<const L: usize> {
     pub(super) lane_p: Vec<DVec3>,
     pub(super) lane_scratch: Vec<DVec3>,
     pub(super) lane_lengths: Vec<f32>,
+    /// The lane's multipliers from the direct solve, for the fallback's exact projection.
+    pub(super) lane_mu: Vec<f64>,
     pub(super) constraints: ConstraintScratch,
     pub(super) segment_bounds: SegmentBounds,
 }
@@ -143,6 +145,7 @@ impl<const L: usize> LaneGroup<L> {
         self.lane_scratch.reserve(n);
         self.lane_p.reserve(n);
         self.lane_lengths.reserve(n);
+        self.lane_mu.reserve(n);
         self.constraints.reserve(n);
         self.segment_bounds.reserve(n);
     }

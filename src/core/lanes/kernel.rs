@@ -227,7 +227,9 @@ fn fall_back<const L: usize>(g: &mut LaneGroup<L>, solved: Mask<L>) {
         contacts::extract(&g.p[..n], lane, &mut g.lane_p);
         g.lane_lengths.clear();
         g.lane_lengths.extend(g.lengths[..n - 1].iter().map(|l| l.0[lane]));
-        inextensible::solve_fallback(&mut g.lane_p, &g.lane_lengths, &mut g.constraints);
+        g.lane_mu.clear();
+        g.lane_mu.extend(g.mu[..n - 1].iter().map(|mu| mu.0[lane]));
+        inextensible::solve_fallback(&mut g.lane_p, &g.lane_lengths, &g.lane_mu, &mut g.constraints);
         contacts::write_back(&g.lane_p, lane, &mut g.p[..n]);
     }
 }

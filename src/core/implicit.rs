@@ -1,0 +1,171 @@
+//! The exact projection onto the bond lengths, for the chains whose direct solve fails (bug 1 in
+//! docs/robustness.md): Newton's method on the whole optimality system, positions and multipliers together.
+//!
+//! The projection moves the predicted positions `p` to the nearest `x` (unit masses, the root fixed) whose
+//! bonds `b_k = x[k+1] - x[k]` have their rest lengths. At the answer, `x_j - p_j = mu_{j-1} b_{j-1} - mu_j
+//! b_j`: the corrections act along the answer's own bonds, not the previous substep's (the direct solve) or
+//! the current guess's (the Gauss-Newton projection). Both of those treat the bond directions explicitly, so
+//! a tension wave that crosses more than about one segment per substep sends them astray. Newton on the full
+//! system linearises the directions too: its matrix carries the tension's own stiffness (`mu` times the
+//! chain's graph Laplacian), which is what turns a rope's tension into its sideways pull.
+//!
+//! Ordering the unknowns joint by joint, `(mu_{j-1}, x_j)`, makes that matrix block tridiagonal with 4 x 4
+//! blocks, so each iteration is one block Thomas solve: O(n), with no pivoting across blocks.
+//!
+//! Block `j` (joint `j`, `1 <= j <= m`) holds bond `j-1`'s constraint `c = (|b|^2 - l^2) / 2` and joint
+//! `j`'s stationarity `s = x_j - p_j - mu_{j-1} b_{j-1} + mu_j b_j`. With `b = b_{j-1}`, `mu = mu_{j-1}`
+//! and `t = 1 - mu_{j-1} - mu_j`, its Jacobian blocks are, by rows:
+//! - on its own unknowns `(mu_{j-1}, x_j)`: `[0, b^T]` and `[-b, t I]`;
+//! - on block `j-1`'s `(mu_{j-2}, x_{j-1})`: `[0, -b^T]` and `[0, mu I]`;
+//! - on block `j+1`'s `(mu_j, x_{j+1})`: `[0, 0]` and `[b_j, mu_j I]`.
+//!
+//! The `mu` inside the position blocks (the multipliers' stiffness) count only where they pull (`mu < 0`,
+//! tension): a pushing bond would make those blocks indefinite and the steps wild. That changes the steps,
+//! not the equations solved, so the answer is the same exact projection (on the fine rope of the performance
+//! report, it turned about 40 % failed solves into converged ones).
+
+use glam::{DMat4, DVec3, DVec4};
+
+/// Iterations before giving up. From the failed direct solve's multipliers it takes 5 Newton steps on most
+/// solves of bug 1's fine rope (docs/robustness.md), 6 to 16 on the others.
+const MAX_ITERATIONS: usize = 24;
+/// An error above this many times the start's (or than this, for a start below 1) means Newton has left the
+/// basin it converges from (on its way it may overshoot by a few hundred times); Gauss-Seidel takes over.
+const DIVERGED: f64 = 1e3;
+
+/// Reusable buffers.
+#[derive(Default)]
+pub struct ImplicitScratch {
+    /// One multiplier per bond.
+    mu: Vec<f64>,
+    /// The positions being projected (one per particle).
+    target: Vec<DVec3>,
+    /// Per block: the elimination's inverted pivot (by rows: column `i` is row `i`), then its modified
+    /// right-hand side, which the pass back replaces with the block's step.
+    pivots: Vec<DMat4>,
+    rhs: Vec<DVec4>,
+}
+
+impl ImplicitScratch {
+    pub fn reserve(&mut self, bonds: usize) {
+        if self.mu.len() < bonds {
+            self.mu.resize(bonds, 0.0);
+            self.target.resize(bonds + 1, DVec3::ZERO);
+            self.pivots.resize(bonds, DMat4::ZERO);
+            self.rhs.resize(bonds, DVec4::ZERO);
+        }
+    }
+}
+
+/// Worst relative bond error `| |b|^2 / l^2 - 1 |` (NaN if any is).
+fn worst_error(p: &[DVec3], inv_l2: &[f64]) -> f64 {
+    let mut worst = 0.0f64;
+    for (k, inv) in inv_l2.iter().enumerate() {
+        let error = ((p[k + 1] - p[k]).length_squared() * inv - 1.0).abs();
+        if error.is_nan() || error > worst {
+            worst = error;
+        }
+    }
+    worst
+}
+
+/// The block above-diagonal `[[0, 0], [b, mu I]]` (by rows) times `u`.
+#[inline(always)]
+fn upper_times(b: DVec3, mu: f64, u: DVec4) -> DVec4 {
+    DVec4::new(0.0, b.x * u.x + mu * u.y, b.y * u.x + mu * u.z, b.z * u.x + mu * u.w)
+}
+
+impl ImplicitScratch {
+    /// Remembers the positions `p` to project and the start multipliers `guess`, with their compressions
+    /// dropped (a compressed bond can make the system indefinite). The direct solve's multipliers, even from
+    /// a failed solve, are a good start for a rope's tensions.
+    pub fn begin(&mut self, p: &[DVec3], guess: &[f64]) {
+        let m = guess.len();
+        self.reserve(m);
+        self.target[..m + 1].copy_from_slice(&p[..m + 1]);
+        for (mu, &g) in self.mu.iter_mut().zip(guess) {
+            *mu = g.min(0.0);
+        }
+    }
+}
+
+/// Projects the positions given to [`ImplicitScratch::begin`] (particle 0 fixed) onto the squared bond
+/// lengths `l2` (`inv_l2` their reciprocals), into `p`, to within the relative error `tolerance` of
+/// `|b|^2 / l^2 - 1`. Returns `false` when Newton fails; `p` then holds the positions given to `begin`.
+pub fn project(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &mut ImplicitScratch) -> bool {
+    let m = l2.len();
+    let ImplicitScratch { mu, target, pivots, rhs } = s;
+    let (mu, target, pivots, rhs) = (&mut mu[..m], &target[..m + 1], &mut pivots[..m], &mut rhs[..m]);
+    let p = &mut p[..m + 1];
+    p.copy_from_slice(target);
+    let mut limit = f64::NAN;
+    for iteration in 0..MAX_ITERATIONS {
+        let worst = worst_error(p, inv_l2);
+        if worst <= tolerance {
+            return true;
+        }
+        if iteration == 0 {
+            limit = DIVERGED * worst.max(1.0);
+        }
+        if worst.is_nan() || worst >= limit {
+            break;
+        }
+        eliminate(p, target, mu, l2, pivots, rhs);
+        // The pass back, applying each block's step once the block above no longer needs its old values.
+        let mut next = DVec4::ZERO;
+        let (mut above, mut mu_above) = (DVec3::ZERO, 0.0);
+        for j in (1..=m).rev() {
+            let y = if j < m { rhs[j - 1] - upper_times(above - p[j], mu_above, next) } else { rhs[j - 1] };
+            let q = &pivots[j - 1];
+            next = DVec4::new(q.x_axis.dot(y), q.y_axis.dot(y), q.z_axis.dot(y), q.w_axis.dot(y));
+            (above, mu_above) = (p[j], mu[j - 1].min(0.0));
+            mu[j - 1] += next.x;
+            p[j] += DVec3::new(next.y, next.z, next.w);
+        }
+        if !next.is_finite() {
+            break;
+        }
+    }
+    p.copy_from_slice(target);
+    false
+}
+
+/// The block Thomas algorithm's forward elimination: each block's inverted pivot and right-hand side.
+fn eliminate(p: &[DVec3], target: &[DVec3], mu: &[f64], l2: &[f64], pivots: &mut [DMat4], rhs: &mut [DVec4]) {
+    let m = l2.len();
+    for j in 1..=m {
+        let b = p[j] - p[j - 1];
+        let mu_before = mu[j - 1];
+        let (b_after, mu_after) = if j < m { (p[j + 1] - p[j], mu[j]) } else { (DVec3::ZERO, 0.0) };
+        // The stiffness of the pulling multipliers only (see the module documentation).
+        let (k_before, k_after) = (mu_before.min(0.0), mu_after.min(0.0));
+        let t = 1.0 - k_before - k_after;
+        let constraint = 0.5 * (b.length_squared() - l2[j - 1]);
+        let stationarity = p[j] - target[j] - mu_before * b + mu_after * b_after;
+        // The block's own rows: [0, b^T] and [-b, t I].
+        let mut rows = [
+            DVec4::new(0.0, b.x, b.y, b.z),
+            DVec4::new(-b.x, t, 0.0, 0.0),
+            DVec4::new(-b.y, 0.0, t, 0.0),
+            DVec4::new(-b.z, 0.0, 0.0, t),
+        ];
+        let mut y = -DVec4::new(constraint, stationarity.x, stationarity.y, stationarity.z);
+        if j > 1 {
+            // W = L Q with L = [[0, -b^T], [0, mu I]] and Q the inverted pivot above (rows q0..q3); subtract
+            // W U (U = [[0, 0], [b, mu I]], bond j-1 again) from the rows and W y_above from y.
+            let q = &pivots[j - 2];
+            let (q1, q2, q3) = (q.y_axis, q.z_axis, q.w_axis);
+            let w = [-(q1 * b.x + q2 * b.y + q3 * b.z), q1 * k_before, q2 * k_before, q3 * k_before];
+            let y_above = rhs[j - 2];
+            for (row, w) in rows.iter_mut().zip(w) {
+                let wb = w.y * b.x + w.z * b.y + w.w * b.z;
+                *row -= DVec4::new(wb, w.y * k_before, w.z * k_before, w.w * k_before);
+            }
+            y -= DVec4::new(w[0].dot(y_above), w[1].dot(y_above), w[2].dot(y_above), w[3].dot(y_above));
+        }
+        // Columns of `rows_matrix` are the pivot's rows: it is the pivot transposed, and so is its inverse.
+        let rows_matrix = DMat4::from_cols(rows[0], rows[1], rows[2], rows[3]);
+        pivots[j - 1] = rows_matrix.inverse();
+        rhs[j - 1] = y;
+    }
+}

@@ -1011,6 +1011,7 @@ impl Engine {
             words.extend(chain.frame.lengths.iter().map(|x| x.to_bits() as u64));
             let quats = st.q.iter().chain(&st.group_rotation).chain(&chain.rest.orientations);
             words.extend(quats.flat_map(|q| q.to_array()).map(|x| x.to_bits() as u64));
+            words.extend(st.solve_memory.words());
             for t in [&chain.anchor, &chain.anchor_pending]
                 .into_iter()
                 .chain(&chain.output)

@@ -89,6 +89,13 @@ impl ImplicitScratch {
     }
 }
 
+impl ImplicitScratch {
+    /// The multipliers of the last projection, for a chain of `bonds` bonds.
+    pub fn multipliers(&self, bonds: usize) -> &[f64] {
+        &self.mu[..bonds]
+    }
+}
+
 /// Projects the positions given to [`ImplicitScratch::begin`] (particle 0 fixed) onto the squared bond
 /// lengths `l2` (`inv_l2` their reciprocals), into `p`, to within the relative error `tolerance` of
 /// `|b|^2 / l^2 - 1`. Returns `false` when Newton fails; `p` then holds the positions given to `begin`.

@@ -99,35 +99,155 @@ pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintSc
 
 /// [`solve`] with the previous positions given to the last [`prepare`] (with the same `lengths`).
 pub fn solve_prepared(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> bool {
+    solve_direct(p, lengths, s) == Solved::Direct
+}
+
+/// Which solve met the lengths.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solved {
+    Direct,
+    GaussNewton,
+    Exact,
+    GaussSeidel,
+}
+
+fn solve_direct(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> Solved {
     let m = lengths.len();
     debug_assert!(p.len() == m + 1 && s.start_bonds.len() >= m);
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
     if newton_along_directions(p, &s.start_bonds[..m], l2, inv_l2, &mut s.newton) {
-        return true;
+        return Solved::Direct;
     }
-    fall_back(p, lengths, s);
-    false
+    fall_back(p, lengths, s)
 }
 
-/// What [`solve_prepared`] does when the direct solve fails, for a solver that ran its own direct solve (the
-/// lane path), whose last multipliers are `multipliers`: see `fall_back`.
-pub fn solve_fallback(p: &mut [DVec3], lengths: &[f32], multipliers: &[f64], s: &mut ConstraintScratch) {
+/// What a chain's solves learn for its next substep: where the direct solve fails on a substep's first
+/// solve (long or fine chains, bug 1 in docs/robustness.md), it fails on the next substep's too, and the
+/// tensions hardly change in a substep. Part of the chain's state.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolveMemory {
+    /// The multipliers of the last exact projection, one per bond (room for them from the start, so that no
+    /// step allocates).
+    tension: Vec<f64>,
+    /// Substeps in a row whose first solve took the exact projection.
+    exact_streak: u32,
+}
+
+/// A chain whose first solves keep taking the exact projection tries the direct solve again every this many
+/// substeps (every 33 ms at the default 240 Hz), so that it goes back to it soon after it works again.
+const RETRY_DIRECT: u32 = 8;
+
+impl SolveMemory {
+    pub fn new(bonds: usize) -> Self {
+        Self { tension: vec![0.0; bonds], exact_streak: 0 }
+    }
+
+    /// Forgets what was learnt (the chain was placed anew).
+    pub fn forget(&mut self) {
+        self.exact_streak = 0;
+    }
+
+    /// Words for the engine's state hash (the tensions only while they are used).
+    pub fn words(&self) -> impl Iterator<Item = u64> + '_ {
+        let used = if self.exact_streak > 0 { &self.tension[..] } else { &[] };
+        std::iter::once(self.exact_streak as u64).chain(used.iter().map(|t| t.to_bits()))
+    }
+}
+
+/// [`solve_prepared`] for the first solve of a substep, with what the chain's previous substep learnt: while
+/// its first solves need the exact projection, this one goes straight to it, from the last one's tensions
+/// (the direct solve and the Gauss-Newton projection would fail first, and the start is closer), except every
+/// [`RETRY_DIRECT`]-th substep. Returns `false` when the direct solve was not used.
+pub fn solve_first(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, memory: &mut SolveMemory) -> bool {
+    if exact_from_memory(p, lengths, s, memory) {
+        return false;
+    }
+    let solved = solve_direct(p, lengths, s);
+    memory.learn(solved, s, lengths.len());
+    solved == Solved::Direct
+}
+
+/// The first step of [`solve_first`]: the exact projection from the remembered tensions, if the chain's
+/// first solves have been taking it. Returns whether it ran and converged (`p` is untouched otherwise).
+pub fn exact_from_memory(
+    p: &mut [DVec3],
+    lengths: &[f32],
+    s: &mut ConstraintScratch,
+    memory: &mut SolveMemory,
+) -> bool {
+    let m = lengths.len();
+    if memory.tension.len() != m || !memory.wants_exact() {
+        return false;
+    }
+    set_lengths(lengths, s);
+    let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
+    s.implicit.begin(p, &memory.tension);
+    if !implicit::project(p, l2, inv_l2, TOLERANCE, &mut s.implicit) {
+        return false;
+    }
+    memory.tension.copy_from_slice(s.implicit.multipliers(m));
+    memory.exact_streak += 1;
+    true
+}
+
+impl SolveMemory {
+    /// What a first solve that ran the direct solve (`solved` says how it ended) teaches.
+    pub fn learn(&mut self, solved: Solved, s: &ConstraintScratch, bonds: usize) {
+        if solved == Solved::Exact && self.tension.len() == bonds {
+            self.tension.copy_from_slice(s.implicit.multipliers(bonds));
+            self.exact_streak += 1;
+        } else {
+            self.exact_streak = 0;
+        }
+    }
+
+    /// Whether the last first solves took the exact projection.
+    pub fn in_streak(&self) -> bool {
+        self.exact_streak > 0
+    }
+
+    /// Whether the next first solve starts with the exact projection.
+    pub fn wants_exact(&self) -> bool {
+        self.exact_streak % RETRY_DIRECT != 0
+    }
+
+    /// `self = other`, in the room `self` has (no allocation once it has held a chain of that length). The
+    /// tensions are only read while the streak runs, and written before it starts, so they are copied only
+    /// then: most chains never fall back, and their memory costs a word.
+    pub fn copy_from(&mut self, other: &SolveMemory) {
+        if other.exact_streak > 0 || self.tension.len() != other.tension.len() {
+            self.tension.clear();
+            self.tension.extend_from_slice(&other.tension);
+        }
+        self.exact_streak = other.exact_streak;
+    }
+}
+
+fn set_lengths(lengths: &[f32], s: &mut ConstraintScratch) {
     let m = lengths.len();
     s.reserve(m);
     for k in 0..m {
+        // Exact: a float32 squared fits in a double.
         let l2 = lengths[k] as f64 * lengths[k] as f64;
         s.length_squared[k] = l2;
         s.inverse_length_squared[k] = 1.0 / l2;
     }
+}
+
+/// What [`solve_prepared`] does when the direct solve fails, for a solver that ran its own direct solve (the
+/// lane path), whose last multipliers are `multipliers`: see `fall_back`.
+pub fn solve_fallback(p: &mut [DVec3], lengths: &[f32], multipliers: &[f64], s: &mut ConstraintScratch) -> Solved {
+    let m = lengths.len();
+    set_lengths(lengths, s);
     s.newton.mu[..m].copy_from_slice(&multipliers[..m]);
-    fall_back(p, lengths, s);
+    fall_back(p, lengths, s)
 }
 
 /// After a failed direct solve (its last multipliers in `s.newton.mu`): the Gauss-Newton projection along
 /// the current bonds, cheap where it converges (hair-length segments); if it fails, the exact projection
 /// (`implicit`), which converges on the fine ropes that defeat both (bug 1); if even that fails,
 /// Gauss-Seidel sweeps from the positions the fallback was given.
-fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
+fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> Solved {
     let m = lengths.len();
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
     // The Gauss-Newton projection moves `p` and overwrites the multipliers: keep both for the exact one.
@@ -136,11 +256,13 @@ fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
         s.current_bonds[k] = p[k + 1] - p[k];
     }
     if project_relinearized(p, &mut s.current_bonds[..m], l2, inv_l2, &mut s.newton) {
-        return;
+        return Solved::GaussNewton;
     }
-    if !implicit::project(p, l2, inv_l2, TOLERANCE, &mut s.implicit) {
-        project_gauss_seidel(p, lengths);
+    if implicit::project(p, l2, inv_l2, TOLERANCE, &mut s.implicit) {
+        return Solved::Exact;
     }
+    project_gauss_seidel(p, lengths);
+    Solved::GaussSeidel
 }
 
 /// Gauss-Newton projection of `p` onto the bond lengths: each iteration corrects along the bonds as they are

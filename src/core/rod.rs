@@ -5,7 +5,7 @@
 use glam::{DVec3, Mat3A, Quat, Vec3, Vec3A};
 
 use super::collision::{ContactInput, SegmentBounds, collide, pre_stabilise};
-use super::inextensible::{self, ConstraintScratch};
+use super::inextensible::{self, ConstraintScratch, SolveMemory};
 use super::math::{Transform, align_hemisphere, exp_small, log_small, nlerp_shorter};
 use super::params::{ChainParams, EngineSettings};
 use super::polar::extract_rotation;
@@ -33,6 +33,8 @@ pub struct RodState {
     pub w: Vec<Vec3>,
     /// Each shape-matching group's last rotation: the warm start of the next extraction.
     pub group_rotation: Vec<Quat>,
+    /// What the lengths solve learnt for the next substep (the scalar solver's).
+    pub solve_memory: SolveMemory,
 }
 
 impl RodState {
@@ -45,6 +47,7 @@ impl RodState {
             q: vec![Quat::IDENTITY; n],
             w: vec![Vec3::ZERO; n],
             group_rotation: vec![anchor.rotation; n],
+            solve_memory: SolveMemory::new(n.saturating_sub(1)),
         };
         s.place_at_rest(rest, anchor);
         s
@@ -58,6 +61,7 @@ impl RodState {
         self.v.fill(Vec3::ZERO);
         self.w.fill(Vec3::ZERO);
         self.group_rotation.fill(anchor.rotation);
+        self.solve_memory.forget();
     }
 
     /// Moves the whole chain rigidly by `delta` (a teleport carried with the anchor); velocities turn
@@ -214,7 +218,12 @@ pub fn substep(
                 alpha,
             );
         }
-        report.fallback |= !inextensible::solve_prepared(p, lengths, constraints);
+        let solved = if iteration == 0 {
+            inextensible::solve_first(p, lengths, constraints, &mut state.solve_memory)
+        } else {
+            inextensible::solve_prepared(p, lengths, constraints)
+        };
+        report.fallback |= !solved;
         if let Some(contacts) = &input.contacts {
             let mut pass = collide(&mut state.x, p, contacts, bounds);
             inextensible::prepare(&state.x, lengths, constraints);

@@ -7,7 +7,7 @@ use super::contacts::LaneContacts;
 use super::simd::{D, DV3, F, Mask, Q, V3};
 use crate::core::collider::ColliderSweep;
 use crate::core::collision::SegmentBounds;
-use crate::core::inextensible::ConstraintScratch;
+use crate::core::inextensible::{ConstraintScratch, SolveMemory};
 use crate::core::math::Transform;
 use crate::core::rod::{ChainConstants, RodState};
 use crate::core::shape::Shape;
@@ -80,6 +80,8 @@ pub struct LaneGroup<const L: usize> {
     pub(super) lane_lengths: Vec<f32>,
     /// The lane's multipliers from the direct solve, for the fallback's exact projection.
     pub(super) lane_mu: Vec<f64>,
+    /// Each lane's chain's `RodState::solve_memory`, loaded and stored with it.
+    pub(super) memories: Vec<SolveMemory>,
     pub(super) constraints: ConstraintScratch,
     pub(super) segment_bounds: SegmentBounds,
 }
@@ -146,6 +148,7 @@ impl<const L: usize> LaneGroup<L> {
         self.lane_p.reserve(n);
         self.lane_lengths.reserve(n);
         self.lane_mu.reserve(n);
+        self.memories.resize_with(L, SolveMemory::default);
         self.constraints.reserve(n);
         self.segment_bounds.reserve(n);
     }
@@ -184,6 +187,7 @@ impl<const L: usize> LaneGroup<L> {
         self.gravity.set(lane, constants.gravity.to_array());
         self.orientation_weight.0[lane] = constants.orientation_weight;
         self.half_kick.0[lane] = chain.half_kick;
+        self.memories[lane].copy_from(&st.solve_memory);
     }
 
     /// The contacts of `lane` this step: `find` writes the colliders its chain can touch (indices in collider
@@ -248,5 +252,6 @@ impl<const L: usize> LaneGroup<L> {
             state.w[j] = Vec3::from_array(self.w[j].get(lane));
             state.group_rotation[j] = Quat::from_array(self.group_rotation[j].get(lane));
         }
+        state.solve_memory.copy_from(&self.memories[lane]);
     }
 }

@@ -9,7 +9,7 @@ use super::group::LaneGroup;
 use super::lengths::{Passes, solve_lengths};
 use super::rotations::{Predict, Spin, angular_velocities, predict_orientations};
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
-use crate::core::inextensible;
+use crate::core::inextensible::{self, SolveMemory, Solved};
 use crate::core::rod::FINAL_CONTACT_ROUNDS;
 
 /// The vector phases of a substep, each compiled as its own function (a copy per instruction set:
@@ -38,8 +38,8 @@ impl<const L: usize> Phases<L> {
 pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, phases: &Phases<L>) -> Mask<L> {
     (phases.begin)(g, s);
     let mut fell_back = Mask([false; L]);
-    for _ in 0..iterations(g) {
-        fell_back = fell_back.or(iterate(g, phases));
+    for iteration in 0..iterations(g) {
+        fell_back = fell_back.or(iterate(g, phases, iteration == 0));
     }
     (phases.finish)(g);
     fell_back
@@ -58,7 +58,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
     let mut fell_back = Mask([false; L]);
     let mut pairs = 0;
     for iteration in 0..iterations {
-        fell_back = fell_back.or(iterate(g, phases));
+        fell_back = fell_back.or(iterate(g, phases, iteration == 0));
         pairs += contacts::collide(g, touching);
         start_bonds(g);
         if iteration + 1 == iterations {
@@ -71,7 +71,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
                 let failed = again.and(solved.not());
                 if failed.any() {
                     fell_back = fell_back.or(failed);
-                    fall_back(g, failed.not());
+                    fall_back(g, failed, false);
                 }
                 pairs += contacts::collide(g, again);
                 start_bonds(g);
@@ -121,16 +121,46 @@ pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, predict: Pr
 }
 
 /// One solver iteration: shape matching, then the lengths on every lane. Returns the lanes that fell back.
-fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>) -> Mask<L> {
+/// The first iteration's solve is `inextensible::solve_first` on every lane: lanes whose chains' first
+/// solves have been taking the exact projection start with it, from their remembered tensions.
+fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>, first: bool) -> Mask<L> {
     if g.shape_matching {
         (phases.match_shape)(g);
     }
-    let solved = (phases.solve_lengths)(g, Mask([true; L]));
-    if solved.0.iter().all(|&ok| ok) {
-        return Mask([false; L]);
+    // Most groups have no lane that remembers anything.
+    let remembering = first && g.memories.iter().any(SolveMemory::in_streak);
+    let direct = if remembering { exact_from_memory(g) } else { Mask([true; L]) };
+    let solved = (phases.solve_lengths)(g, direct);
+    if remembering {
+        for lane in (0..L).filter(|&lane| solved.0[lane]) {
+            g.memories[lane].learn(Solved::Direct, &g.constraints, g.n - 1);
+        }
     }
-    fall_back(g, solved);
+    let failed = direct.and(solved.not());
+    if failed.any() {
+        fall_back(g, failed, first);
+    }
     solved.not()
+}
+
+/// `inextensible::exact_from_memory` on every lane; returns the lanes it did not solve.
+#[cold]
+fn exact_from_memory<const L: usize>(g: &mut LaneGroup<L>) -> Mask<L> {
+    let n = g.n;
+    let mut left = Mask([true; L]);
+    for lane in 0..L {
+        if !g.memories[lane].wants_exact() {
+            continue;
+        }
+        contacts::extract(&g.p[..n], lane, &mut g.lane_p);
+        g.lane_lengths.clear();
+        g.lane_lengths.extend(g.lengths[..n - 1].iter().map(|l| l.0[lane]));
+        if inextensible::exact_from_memory(&mut g.lane_p, &g.lane_lengths, &mut g.constraints, &mut g.memories[lane]) {
+            contacts::write_back(&g.lane_p, lane, &mut g.p[..n]);
+            left.0[lane] = false;
+        }
+    }
+    left
 }
 
 /// Velocities from positions; the end of the substep becomes the start of the next.
@@ -216,12 +246,13 @@ fn pull_to_goal<const L: usize>(p: DV3<L>, centre: DV3<L>, offset: V3<L>, alpha:
     p + (goal - p).scale(alpha)
 }
 
-/// The scalar fallback for every lane not in `solved` (or not to be solved), one lane at a time.
+/// The scalar fallback for every lane in `failed`, one lane at a time; a substep's first solve (`learn`)
+/// also updates the lane's solve memory.
 #[cold]
-fn fall_back<const L: usize>(g: &mut LaneGroup<L>, solved: Mask<L>) {
+fn fall_back<const L: usize>(g: &mut LaneGroup<L>, failed: Mask<L>, learn: bool) {
     let n = g.n;
     for lane in 0..L {
-        if solved.0[lane] {
+        if !failed.0[lane] {
             continue;
         }
         contacts::extract(&g.p[..n], lane, &mut g.lane_p);
@@ -229,7 +260,10 @@ fn fall_back<const L: usize>(g: &mut LaneGroup<L>, solved: Mask<L>) {
         g.lane_lengths.extend(g.lengths[..n - 1].iter().map(|l| l.0[lane]));
         g.lane_mu.clear();
         g.lane_mu.extend(g.mu[..n - 1].iter().map(|mu| mu.0[lane]));
-        inextensible::solve_fallback(&mut g.lane_p, &g.lane_lengths, &g.lane_mu, &mut g.constraints);
+        let solved = inextensible::solve_fallback(&mut g.lane_p, &g.lane_lengths, &g.lane_mu, &mut g.constraints);
+        if learn {
+            g.memories[lane].learn(solved, &g.constraints, n - 1);
+        }
         contacts::write_back(&g.lane_p, lane, &mut g.p[..n]);
     }
 }

@@ -25,6 +25,7 @@
 //! report, it turned about 40 % failed solves into converged ones).
 
 use glam::{DMat3, DMat4, DVec3, DVec4};
+use multiversion::multiversion;
 
 /// Iterations before giving up. From the failed direct solve's multipliers it takes 5 Newton steps on most
 /// solves of bug 1's fine rope (docs/robustness.md), 6 to 16 on the others.
@@ -57,7 +58,15 @@ impl ImplicitScratch {
     }
 }
 
+/// A multiplier where it pulls (negative), else 0. Written out rather than `f64::min`, whose result for
+/// `-0.0` against `0.0` is left open, so that every compiled copy gives the same bits.
+#[inline(always)]
+fn pulling(mu: f64) -> f64 {
+    if mu < 0.0 { mu } else { 0.0 }
+}
+
 /// Worst relative bond error `| |b|^2 / l^2 - 1 |` (NaN if any is).
+#[inline(always)]
 fn worst_error(p: &[DVec3], inv_l2: &[f64]) -> f64 {
     let mut worst = 0.0f64;
     for (k, inv) in inv_l2.iter().enumerate() {
@@ -84,7 +93,7 @@ impl ImplicitScratch {
         self.reserve(m);
         self.target[..m + 1].copy_from_slice(&p[..m + 1]);
         for (mu, &g) in self.mu.iter_mut().zip(guess) {
-            *mu = g.min(0.0);
+            *mu = pulling(g);
         }
     }
 }
@@ -99,7 +108,20 @@ impl ImplicitScratch {
 /// Projects the positions given to [`ImplicitScratch::begin`] (particle 0 fixed) onto the squared bond
 /// lengths `l2` (`inv_l2` their reciprocals), into `p`, to within the relative error `tolerance` of
 /// `|b|^2 / l^2 - 1`. Returns `false` when Newton fails; `p` then holds the positions given to `begin`.
+#[multiversion(targets("x86_64+avx2"))]
 pub fn project(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &mut ImplicitScratch) -> bool {
+    project_in(p, l2, inv_l2, tolerance, s)
+}
+
+/// [`project`] compiled for the baseline instruction set only: the tests check that both copies give the same
+/// bits (no fused or reordered operations), as the lane kernels' copies do.
+#[cfg(test)]
+pub fn project_portable(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &mut ImplicitScratch) -> bool {
+    project_in(p, l2, inv_l2, tolerance, s)
+}
+
+#[inline(always)]
+fn project_in(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &mut ImplicitScratch) -> bool {
     let m = l2.len();
     let ImplicitScratch { mu, target, pivots, rhs } = s;
     let (mu, target, pivots, rhs) = (&mut mu[..m], &target[..m + 1], &mut pivots[..m], &mut rhs[..m]);
@@ -125,7 +147,7 @@ pub fn project(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &
             let y = if j < m { rhs[j - 1] - upper_times(above - p[j], mu_above, next) } else { rhs[j - 1] };
             let q = &pivots[j - 1];
             next = DVec4::new(q.x_axis.dot(y), q.y_axis.dot(y), q.z_axis.dot(y), q.w_axis.dot(y));
-            (above, mu_above) = (p[j], mu[j - 1].min(0.0));
+            (above, mu_above) = (p[j], pulling(mu[j - 1]));
             mu[j - 1] += next.x;
             p[j] += DVec3::new(next.y, next.z, next.w);
         }
@@ -138,6 +160,7 @@ pub fn project(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &
 }
 
 /// The block Thomas algorithm's forward elimination: each block's inverted pivot and right-hand side.
+#[inline(always)]
 fn eliminate(p: &[DVec3], target: &[DVec3], mu: &[f64], l2: &[f64], pivots: &mut [DMat4], rhs: &mut [DVec4]) {
     let m = l2.len();
     for j in 1..=m {
@@ -145,7 +168,7 @@ fn eliminate(p: &[DVec3], target: &[DVec3], mu: &[f64], l2: &[f64], pivots: &mut
         let mu_before = mu[j - 1];
         let (b_after, mu_after) = if j < m { (p[j + 1] - p[j], mu[j]) } else { (DVec3::ZERO, 0.0) };
         // The stiffness of the pulling multipliers only (see the module documentation).
-        let (k_before, k_after) = (mu_before.min(0.0), mu_after.min(0.0));
+        let (k_before, k_after) = (pulling(mu_before), pulling(mu_after));
         let t = 1.0 - k_before - k_after;
         let constraint = 0.5 * (b.length_squared() - l2[j - 1]);
         let stationarity = p[j] - target[j] - mu_before * b + mu_after * b_after;
@@ -179,6 +202,7 @@ fn eliminate(p: &[DVec3], target: &[DVec3], mu: &[f64], l2: &[f64], pivots: &mut
 /// through its lower right 3 x 3 block `M` (the position block, `t I` and a correction, far from singular)
 /// and the Schur complement of `M`: a third of the instructions of a general 4 x 4 inverse, which took two
 /// thirds of each iteration. Not finite when the matrix or `M` is singular.
+#[inline(always)]
 fn invert_bordered(rows: &[DVec4; 4]) -> DMat4 {
     let yzw = |v: DVec4| DVec3::new(v.y, v.z, v.w);
     let (corner, top) = (rows[0].x, yzw(rows[0]));

@@ -569,6 +569,15 @@ mod tests {
         let mut projected = predicted.clone();
         s.implicit.begin(&projected, &multipliers);
         assert!(implicit::project(&mut projected, l2, inv_l2, TOLERANCE, &mut s.implicit));
+        let mut portable = predicted.clone();
+        s.implicit.begin(&portable, &multipliers);
+        assert!(implicit::project_portable(&mut portable, l2, inv_l2, TOLERANCE, &mut s.implicit));
+        assert!(
+            projected
+                .iter()
+                .zip(&portable)
+                .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits))
+        );
         assert!(max_stretch(&projected, &lengths) < 1e-6, "{}", max_stretch(&projected, &lengths));
         assert_eq!(projected[0], x[0]);
         let (nearest, other) = (distance(&projected), distance(&direct));

@@ -213,7 +213,8 @@ typedef struct kdw_engine_stats {
     // Always 0: keeps the 64-bit fields that follow aligned without hidden padding.
     uint32_t reserved;
     uint64_t substeps_total;
-    // Internal steps where the direct inextensibility solve failed and a fallback ran.
+    // Internal steps where the direct inextensibility solve failed, or was skipped for a chain whose first
+    // solves keep failing it, and a fallback ran.
     uint64_t solver_fallbacks;
     // Simulated seconds dropped because a step needed more than `max_substeps`.
     double time_dropped;

@@ -729,7 +729,8 @@ namespace Kodawari.Native
         public uint reserved;
         public ulong substeps_total;
         /// <summary>
-        ///  Internal steps where the direct inextensibility solve failed and a fallback ran.
+        ///  Internal steps where the direct inextensibility solve failed, or was skipped for a chain whose first
+        ///  solves keep failing it, and a fallback ran.
         /// </summary>
         public ulong solver_fallbacks;
         /// <summary>

@@ -29,7 +29,8 @@ pub struct Stats {
     pub substeps_last_step: u32,
     /// Chains that cost nothing in the last step (sleeping or disabled). Always 0 until sleeping lands.
     pub chains_asleep: u32,
-    /// Substeps where the direct inextensibility solve failed and the fallback ran.
+    /// Substeps where the direct inextensibility solve failed, or was skipped for a chain whose first solves
+    /// keep failing it, and a fallback ran.
     pub solver_fallbacks: u64,
     pub substeps_total: u64,
     /// Simulated seconds dropped because a call needed more than `max_substeps`.

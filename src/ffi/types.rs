@@ -157,7 +157,8 @@ pub struct kdw_engine_stats {
     /// Always 0: keeps the 64-bit fields that follow aligned without hidden padding.
     pub reserved: u32,
     pub substeps_total: u64,
-    /// Internal steps where the direct inextensibility solve failed and a fallback ran.
+    /// Internal steps where the direct inextensibility solve failed, or was skipped for a chain whose first
+    /// solves keep failing it, and a fallback ran.
     pub solver_fallbacks: u64,
     /// Simulated seconds dropped because a step needed more than `max_substeps`.
     pub time_dropped: f64,

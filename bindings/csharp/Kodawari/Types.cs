@@ -154,7 +154,7 @@ namespace Kodawari
         /// or disabled. 0 on <see cref="Solver.Scalar"/>.</summary>
         public int LaneChains;
         public long SubstepsTotal;
-        /// <summary>Internal steps where the direct inextensibility solve failed and a fallback ran.</summary>
+        /// <summary>Internal steps where the direct inextensibility solve failed (or was skipped for a chain whose first solves keep failing it) and a fallback ran.</summary>
         public long SolverFallbacks;
         /// <summary>Simulated seconds dropped because a step needed more than MaxSubsteps.</summary>
         public double TimeDropped;

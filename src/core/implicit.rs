@@ -41,9 +41,9 @@ pub struct ImplicitScratch {
     mu: Vec<f64>,
     /// The positions being projected (one per particle).
     target: Vec<DVec3>,
-    /// Per block: the elimination's inverted pivot (by rows: column `i` is row `i`), then its modified
-    /// right-hand side, which the pass back replaces with the block's step.
+    /// Per block: the elimination's inverted pivot (by rows: column `i` is row `i`).
     pivots: Vec<DMat4>,
+    /// Per block: the elimination's modified right-hand side, which the pass back reads.
     rhs: Vec<DVec4>,
 }
 
@@ -86,14 +86,14 @@ fn upper_times(b: DVec3, mu: f64, u: DVec4) -> DVec4 {
 
 impl ImplicitScratch {
     /// Remembers the positions `p` to project and the start multipliers `guess`, with their compressions
-    /// dropped (a compressed bond can make the system indefinite). The direct solve's multipliers, even from
+    /// (and any that is not finite) dropped (a compressed bond can make the system indefinite). The direct solve's multipliers, even from
     /// a failed solve, are a good start for a rope's tensions.
     pub fn begin(&mut self, p: &[DVec3], guess: &[f64]) {
         let m = guess.len();
         self.reserve(m);
         self.target[..m + 1].copy_from_slice(&p[..m + 1]);
         for (mu, &g) in self.mu.iter_mut().zip(guess) {
-            *mu = pulling(g);
+            *mu = if g.is_finite() { pulling(g) } else { 0.0 };
         }
     }
 }

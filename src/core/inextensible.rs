@@ -89,9 +89,10 @@ pub fn prepare(x: &[DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
 /// Moves `p` so that `|p[k+1] - p[k]| = lengths[k]` for every bond, correcting along the previous
 /// positions' bonds `x[k+1] - x[k]`. Particle 0 never moves. Returns `false` when that direct solve failed
 /// (a bond turned by about 90 degrees in one substep, as at the tip of a whipping rope, or a long chain of
-/// millimetre segments whose multipliers dwarf its segments) and the fallback ran: a Gauss-Newton projection
-/// along the current bonds, re-read every iteration (not symplectic), then, if even that fails, Gauss-Seidel
-/// projection.
+/// millimetre segments whose multipliers dwarf its segments) and the fallback ran (see `fall_back`): a
+/// Gauss-Newton projection along the current bonds, re-read every iteration (not symplectic); if that fails,
+/// the exact projection ([`implicit`]); if even that fails, Gauss-Seidel projection from the positions the
+/// fallback was given.
 pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> bool {
     prepare(x, lengths, s);
     solve_prepared(p, lengths, s)
@@ -357,6 +358,11 @@ fn newton_along_directions(
         }
         previous_worst = pass.worst;
         if !pass.pivots_usable() {
+            if iteration == 0 {
+                // No step was taken: the fallback must not start from an earlier solve's multipliers (the
+                // scratch is shared by every chain).
+                mu.fill(0.0);
+            }
             return false;
         }
         let update = if iteration == 0 { Update::Replace } else { Update::Add };
@@ -375,8 +381,8 @@ enum Update {
 }
 
 /// The Thomas algorithm's pass back: solves for the step from the forward elimination's `c_prime` and
-/// `d_prime` and replaces `mu` with it or adds it. Returns `false` if the step is not finite (`mu` is then
-/// written over by the next solve before it is read).
+/// `d_prime` and replaces `mu` with it or adds it. Returns `false` if the step is not finite (the fallback's
+/// exact projection then starts from no multiplier where they are not finite).
 #[inline]
 fn back_substitute(c_prime: &[f64], d_prime: &[f64], mu: &mut [f64], update: Update) -> bool {
     // A non-finite entry makes every later one non-finite (`x - c * inf` is infinite or NaN, `0 * inf` NaN),

@@ -55,6 +55,16 @@ pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, passe
         }
         active = active.and(pass.diverging(previous_worst).not()).and(pass.pivots_usable());
         previous_worst = pass.worst;
+        if iteration == 0 {
+            // Lanes that fail before their first step keep no multipliers from an earlier solve (another
+            // chain may have held the lane): their fallback starts from none, as on the scalar solver.
+            let stopped = lanes.and(active.not()).and(solved.not());
+            if stopped.any() {
+                for mu in &mut g.mu[..m] {
+                    *mu = D::select(stopped, D::splat(0.0), *mu);
+                }
+            }
+        }
         if !active.any() {
             break;
         }

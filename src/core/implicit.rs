@@ -10,7 +10,8 @@
 //! chain's graph Laplacian), which is what turns a rope's tension into its sideways pull.
 //!
 //! Ordering the unknowns joint by joint, `(mu_{j-1}, x_j)`, makes that matrix block tridiagonal with 4 x 4
-//! blocks, so each iteration is one block Thomas solve: O(n), with no pivoting across blocks.
+//! blocks, so each iteration is one block Thomas solve: O(n), with no pivoting across blocks, run from both
+//! ends at once (see `newton_step`).
 //!
 //! Block `j` (joint `j`, `1 <= j <= m`) holds bond `j-1`'s constraint `c = (|b|^2 - l^2) / 2` and joint
 //! `j`'s stationarity `s = x_j - p_j - mu_{j-1} b_{j-1} + mu_j b_j`. With `b = b_{j-1}`, `mu = mu_{j-1}`
@@ -139,19 +140,7 @@ fn project_in(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &m
         if worst.is_nan() || worst >= limit {
             break;
         }
-        eliminate(p, target, mu, l2, pivots, rhs);
-        // The pass back, applying each block's step once the block above no longer needs its old values.
-        let mut next = DVec4::ZERO;
-        let (mut above, mut mu_above) = (DVec3::ZERO, 0.0);
-        for j in (1..=m).rev() {
-            let y = if j < m { rhs[j - 1] - upper_times(above - p[j], mu_above, next) } else { rhs[j - 1] };
-            let q = &pivots[j - 1];
-            next = DVec4::new(q.x_axis.dot(y), q.y_axis.dot(y), q.z_axis.dot(y), q.w_axis.dot(y));
-            (above, mu_above) = (p[j], pulling(mu[j - 1]));
-            mu[j - 1] += next.x;
-            p[j] += DVec3::new(next.y, next.z, next.w);
-        }
-        if !next.is_finite() {
+        if !newton_step(p, target, mu, l2, pivots, rhs) {
             break;
         }
     }
@@ -159,43 +148,151 @@ fn project_in(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &m
     false
 }
 
-/// The block Thomas algorithm's forward elimination: each block's inverted pivot and right-hand side.
+/// One block's rows of the Newton system before elimination, and the bonds and stiffnesses that couple it to
+/// its neighbours. Block `i` is joint `i + 1` with the multiplier of bond `i`.
+struct Block {
+    rows: [DVec4; 4],
+    f: DVec4,
+    /// Bond `i` and its multiplier's stiffness (the coupling to block `i - 1`).
+    b_in: DVec3,
+    k_in: f64,
+    /// Bond `i + 1` and its stiffness (the coupling to block `i + 1`; zero at the tip).
+    b_out: DVec3,
+    k_out: f64,
+}
+
 #[inline(always)]
-fn eliminate(p: &[DVec3], target: &[DVec3], mu: &[f64], l2: &[f64], pivots: &mut [DMat4], rhs: &mut [DVec4]) {
+fn block(p: &[DVec3], target: &[DVec3], mu: &[f64], l2: &[f64], i: usize) -> Block {
     let m = l2.len();
-    for j in 1..=m {
-        let b = p[j] - p[j - 1];
-        let mu_before = mu[j - 1];
-        let (b_after, mu_after) = if j < m { (p[j + 1] - p[j], mu[j]) } else { (DVec3::ZERO, 0.0) };
-        // The stiffness of the pulling multipliers only (see the module documentation).
-        let (k_before, k_after) = (pulling(mu_before), pulling(mu_after));
-        let t = 1.0 - k_before - k_after;
-        let constraint = 0.5 * (b.length_squared() - l2[j - 1]);
-        let stationarity = p[j] - target[j] - mu_before * b + mu_after * b_after;
+    let b = p[i + 1] - p[i];
+    let (b_after, mu_after) = if i + 1 < m { (p[i + 2] - p[i + 1], mu[i + 1]) } else { (DVec3::ZERO, 0.0) };
+    // The stiffness of the pulling multipliers only (see the module documentation).
+    let (k_in, k_out) = (pulling(mu[i]), pulling(mu_after));
+    let t = 1.0 - k_in - k_out;
+    let constraint = 0.5 * (b.length_squared() - l2[i]);
+    let stationarity = p[i + 1] - target[i + 1] - mu[i] * b + mu_after * b_after;
+    Block {
         // The block's own rows: [0, b^T] and [-b, t I].
-        let mut rows = [
+        rows: [
             DVec4::new(0.0, b.x, b.y, b.z),
             DVec4::new(-b.x, t, 0.0, 0.0),
             DVec4::new(-b.y, 0.0, t, 0.0),
             DVec4::new(-b.z, 0.0, 0.0, t),
-        ];
-        let mut y = -DVec4::new(constraint, stationarity.x, stationarity.y, stationarity.z);
-        if j > 1 {
-            // W = L Q with L = [[0, -b^T], [0, mu I]] and Q the inverted pivot above (rows q0..q3); subtract
-            // W U (U = [[0, 0], [b, mu I]], bond j-1 again) from the rows and W y_above from y.
-            let q = &pivots[j - 2];
-            let (q1, q2, q3) = (q.y_axis, q.z_axis, q.w_axis);
-            let w = [-(q1 * b.x + q2 * b.y + q3 * b.z), q1 * k_before, q2 * k_before, q3 * k_before];
-            let y_above = rhs[j - 2];
-            for (row, w) in rows.iter_mut().zip(w) {
-                let wb = w.y * b.x + w.z * b.y + w.w * b.z;
-                *row -= DVec4::new(wb, w.y * k_before, w.z * k_before, w.w * k_before);
-            }
-            y -= DVec4::new(w[0].dot(y_above), w[1].dot(y_above), w[2].dot(y_above), w[3].dot(y_above));
-        }
-        pivots[j - 1] = invert_bordered(&rows);
-        rhs[j - 1] = y;
+        ],
+        f: -DVec4::new(constraint, stationarity.x, stationarity.y, stationarity.z),
+        b_in: b,
+        k_in,
+        b_out: b_after,
+        k_out,
     }
+}
+
+/// Eliminates the block before (`q` its inverted pivot, `y` its right-hand side) from `block`: subtracts
+/// `L Q U` and `L Q y`, with `L = [[0, -b^T], [0, k I]]` and `U = [[0, 0], [b, k I]]` (bond `i`, both).
+#[inline(always)]
+fn eliminate_before(block: &mut Block, q: &DMat4, y: DVec4) {
+    let (b, k) = (block.b_in, block.k_in);
+    let (q1, q2, q3) = (q.y_axis, q.z_axis, q.w_axis);
+    let w = [-(q1 * b.x + q2 * b.y + q3 * b.z), q1 * k, q2 * k, q3 * k];
+    for (row, w) in block.rows.iter_mut().zip(w) {
+        let wb = w.y * b.x + w.z * b.y + w.w * b.z;
+        *row -= DVec4::new(wb, w.y * k, w.z * k, w.w * k);
+    }
+    block.f -= DVec4::new(w[0].dot(y), w[1].dot(y), w[2].dot(y), w[3].dot(y));
+}
+
+/// Eliminates the block after (`q` its inverted pivot, `z` its right-hand side) from `block`: subtracts
+/// `U Q L` and `U Q z`, with `U = [[0, 0], [a, k I]]` and `L = [[0, -a^T], [0, k I]]` (bond `i + 1`, both).
+#[inline(always)]
+fn eliminate_after(block: &mut Block, q: &DMat4, z: DVec4) {
+    let (a, k) = (block.b_out, block.k_out);
+    let q0 = q.x_axis;
+    let v = [q0 * a.x + q.y_axis * k, q0 * a.y + q.z_axis * k, q0 * a.z + q.w_axis * k];
+    for (row, v) in block.rows[1..].iter_mut().zip(v) {
+        let m = -a * v.x + DVec3::new(v.y, v.z, v.w) * k;
+        *row -= DVec4::new(0.0, m.x, m.y, m.z);
+    }
+    let f = &mut block.f;
+    (f.y, f.z, f.w) = (f.y - v[0].dot(z), f.z - v[1].dot(z), f.w - v[2].dot(z));
+}
+
+#[inline(always)]
+fn times(q: &DMat4, v: DVec4) -> DVec4 {
+    DVec4::new(q.x_axis.dot(v), q.y_axis.dot(v), q.z_axis.dot(v), q.w_axis.dot(v))
+}
+
+/// One Newton step: the block tridiagonal system solved from both ends at once (root to middle and tip to
+/// middle, then outwards from the middle). Every block's elimination waits for its neighbour's inverse, so
+/// one pass from the root is bound by that latency; two independent passes interleave and take about half
+/// the time. Applies the step; returns `false` if it is not finite.
+#[inline(always)]
+fn newton_step(
+    p: &mut [DVec3],
+    target: &[DVec3],
+    mu: &mut [f64],
+    l2: &[f64],
+    pivots: &mut [DMat4],
+    rhs: &mut [DVec4],
+) -> bool {
+    let m = l2.len();
+    // Blocks 0..middle from the root, middle + 1..m from the tip, the middle from both.
+    let middle = m / 2;
+    let (down, up) = (middle, m - 1 - middle);
+    for s in 0..down.max(up) {
+        if s < down {
+            let mut b = block(p, target, mu, l2, s);
+            if s > 0 {
+                eliminate_before(&mut b, &pivots[s - 1], rhs[s - 1]);
+            }
+            pivots[s] = invert_bordered(&b.rows);
+            rhs[s] = b.f;
+        }
+        if s < up {
+            let i = m - 1 - s;
+            let mut b = block(p, target, mu, l2, i);
+            if i + 1 < m {
+                eliminate_after(&mut b, &pivots[i + 1], rhs[i + 1]);
+            }
+            pivots[i] = invert_bordered(&b.rows);
+            rhs[i] = b.f;
+        }
+    }
+    let mut b = block(p, target, mu, l2, middle);
+    if middle > 0 {
+        eliminate_before(&mut b, &pivots[middle - 1], rhs[middle - 1]);
+    }
+    if middle + 1 < m {
+        eliminate_after(&mut b, &pivots[middle + 1], rhs[middle + 1]);
+    }
+    let u = times(&invert_bordered(&b.rows), b.f);
+    rhs[middle] = u;
+    // Outwards; `rhs` takes each block's step, applied once every step is known (the couplings use the bonds
+    // and multipliers as they were).
+    let (mut below, mut above) = (u, u);
+    for s in 1..=down.max(up) {
+        if s <= down {
+            let i = middle - s;
+            let coupling = upper_times(p[i + 2] - p[i + 1], pulling(mu[i + 1]), below);
+            below = times(&pivots[i], rhs[i] - coupling);
+            rhs[i] = below;
+        }
+        if s <= up {
+            let i = middle + s;
+            let (b, k) = (p[i + 1] - p[i], pulling(mu[i]));
+            let coupling =
+                DVec4::new(-b.dot(DVec3::new(above.y, above.z, above.w)), k * above.y, k * above.z, k * above.w);
+            above = times(&pivots[i], rhs[i] - coupling);
+            rhs[i] = above;
+        }
+    }
+    let mut finite = true;
+    for i in 0..m {
+        let u = rhs[i];
+        finite &= u.is_finite();
+        mu[i] += u.x;
+        p[i + 1] += DVec3::new(u.y, u.z, u.w);
+    }
+    finite
 }
 
 /// The inverse, by rows (column `i` of the result is its row `i`), of the 4 x 4 matrix with rows `rows`,

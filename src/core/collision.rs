@@ -180,7 +180,7 @@ fn collide_plane(
     let mut deepest = 0.0f32;
     let root_height = sweep.end.to_local(p[0]).y;
     let held = if root_height < input.radii[1] {
-        held_by_root(input.lengths, |j, along| root_height + along * CLEARING_SLANT < input.radii[j])
+        held_by_root(input.lengths, |j, along| root_height + along * CLEARING_SLANT < input.radii[j]).joints
     } else {
         0
     };
@@ -214,7 +214,8 @@ fn collide_inside(
     let root_distance = distance_from_axis(sweep.end.to_local(p[0]), half_height);
     let held = held_by_root(input.lengths, |j, along| {
         root_distance - along * CLEARING_SLANT > (radius - input.radii[j]).max(0.0)
-    });
+    })
+    .joints;
     for j in held + 1..p.len() {
         let local = sweep.end.to_local(p[j]);
         let axis_point = Vec3::new(0.0, local.y.clamp(-half_height, half_height), 0.0);
@@ -260,11 +261,11 @@ fn collide_outside(
         let reach = |j: usize| radius + input.radii[j];
         (held_by_root(input.lengths, |j, along| root_distance + along * CLEARING_SLANT < reach(j)), root_distance)
     } else {
-        (0, f32::INFINITY)
+        (Held::NONE, f32::INFINITY)
     };
     // Segments before `held` join joints the root holds inside (or the root itself): nothing to test.
-    for (i, &(midpoint, segment_reach)) in bounds[held..].iter().enumerate() {
-        let k = held + i;
+    for (i, &(midpoint, segment_reach)) in bounds[held.joints..].iter().enumerate() {
+        let k = held.joints + i;
         let clear = solid + segment_reach + collider_travel + 3.0 * *drift;
         if (midpoint - centre).length_squared() > clear * clear {
             continue;
@@ -278,8 +279,8 @@ fn collide_outside(
         let reach_at = |t: f32| radius + input.radii[k] + (input.radii[k + 1] - input.radii[k]) * t;
         // The segment from the last joint the root holds inside: its points near that joint are held too.
         if k > 0
-            && k == held
-            && root_distance + (along_chain(input.lengths, k) + t * input.lengths[k]) * CLEARING_SLANT < reach_at(t)
+            && k == held.joints
+            && root_distance + (held.along + t * input.lengths[k]) * CLEARING_SLANT < reach_at(t)
         {
             t = 1.0;
         }
@@ -319,20 +320,27 @@ fn collide_outside(
 /// the slant at 1 the bound would be exact for any convex collider, whose distance function changes by at
 /// most the distance moved. Almost always 0 after one test: only a root inside a collider's reach by more
 /// than half its first segment (a hair root within the head sphere's reach, fine segments) holds any.
-fn held_by_root(lengths: &[f32], mut held: impl FnMut(usize, f32) -> bool) -> usize {
+fn held_by_root(lengths: &[f32], mut held: impl FnMut(usize, f32) -> bool) -> Held {
     let mut along = 0.0;
     for (k, &length) in lengths.iter().enumerate() {
-        along += length;
-        if !held(k + 1, along) {
-            return k;
+        if !held(k + 1, along + length) {
+            return Held { joints: k, along };
         }
+        along += length;
     }
-    lengths.len()
+    Held { joints: lengths.len(), along }
 }
 
-/// Rest length from the root to joint `j`.
-fn along_chain(lengths: &[f32], j: usize) -> f32 {
-    lengths[..j].iter().sum()
+/// What [`held_by_root`] found: the first `joints` dynamic joints are held; the last of them is `along` m of
+/// rest length from the root.
+#[derive(Clone, Copy)]
+struct Held {
+    joints: usize,
+    along: f32,
+}
+
+impl Held {
+    const NONE: Self = Self { joints: 0, along: 0.0 };
 }
 
 /// Distance of `q` from the local Y segment of half length `half_height` (a capsule's axis).

@@ -22,17 +22,16 @@
 //!
 //! The `mu` inside the position blocks (the multipliers' stiffness) count only where they pull (`mu < 0`,
 //! tension): a pushing bond would make those blocks indefinite and the steps wild. That changes the steps,
-//! not the equations solved, so the answer is the same exact projection (on the fine rope of the performance
-//! report, it turned about 40 % failed solves into converged ones).
+//! not the equations solved, so the answer is the same exact projection.
 
 use glam::{DMat3, DMat4, DVec3, DVec4};
 use multiversion::multiversion;
 
-/// Iterations before giving up. From the failed direct solve's multipliers it takes 5 Newton steps on most
-/// solves of bug 1's fine rope (docs/robustness.md), 6 to 16 on the others.
+/// Iterations before giving up (it converges quadratically once near; bug 1's fine rope takes a handful,
+/// docs/robustness.md).
 const MAX_ITERATIONS: usize = 24;
 /// An error above this many times the start's (or than this, for a start below 1) means Newton has left the
-/// basin it converges from (on its way it may overshoot by a few hundred times); Gauss-Seidel takes over.
+/// basin it converges from (on its way it may overshoot by far less than that); Gauss-Seidel takes over.
 const DIVERGED: f64 = 1e3;
 
 /// Reusable buffers.

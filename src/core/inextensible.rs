@@ -19,8 +19,8 @@ const FALLBACK_SWEEPS: usize = 64;
 const RELINEARIZED_ITERATIONS: usize = 16;
 /// The relinearized fallback has lost its way once an iteration leaves its bonds off by more than their own
 /// squared length (`|b|^2 / l^2 - 1 > 1`) and this many times its start's error: on bug 1's fine ropes its
-/// first step overshoots by 8 to 500 times and it never recovers within its iterations, where on the hair
-/// ropes it converges on it stays within 4 times.
+/// first step overshoots by far more and it never recovers within its iterations, where on the hair ropes it
+/// converges on it stays within that (docs/robustness.md, bug 1).
 const RELINEARIZED_LOST: f64 = 4.0;
 /// A pivot of the Newton system smaller than this share of its largest diagonal entry counts as vanishing.
 pub(crate) const MIN_PIVOT: f64 = 1e-7;
@@ -76,13 +76,9 @@ impl ConstraintScratch {
 pub fn prepare(x: &[DVec3], lengths: &[f32], s: &mut ConstraintScratch) {
     let m = lengths.len();
     debug_assert!(x.len() == m + 1);
-    s.reserve(m);
+    set_lengths(lengths, s);
     for k in 0..m {
         s.start_bonds[k] = x[k + 1] - x[k];
-        // Exact: a float32 squared fits in a double.
-        let l2 = lengths[k] as f64 * lengths[k] as f64;
-        s.length_squared[k] = l2;
-        s.inverse_length_squared[k] = 1.0 / l2;
     }
 }
 

@@ -105,7 +105,17 @@ pub fn shortest_arc(from: Vec3, to: Vec3) -> Quat {
 #[inline]
 pub fn swing_to(q: Quat, axis: Vec3, direction: Vec3) -> Quat {
     let current = q * axis;
-    (shortest_arc(current, direction) * q).normalize()
+    let cos = current.dot(direction);
+    // Within 90 degrees (every output bone but a folded one) `1 + cos` does not cancel, so float32 gives the
+    // arc to its rounding, without `shortest_arc`'s square roots and divisions in double precision (a tenth of
+    // a frame's time on 1000 x 16 chains). The arc is left unnormalised: the product is normalised anyway.
+    let arc = if cos > 0.0 {
+        let axis = current.cross(direction);
+        Quat::from_xyzw(axis.x, axis.y, axis.z, 1.0 + cos)
+    } else {
+        shortest_arc(current, direction)
+    };
+    (arc * q).normalize()
 }
 
 /// `exp` of a rotation vector: the quaternion turning by `|e|` about `e`, as `Quat::from_scaled_axis`. Short
@@ -205,6 +215,24 @@ mod tests {
         let relative = untwisted.inverse() * q;
         assert!((rotation_angle(relative) - 0.7).abs() < 1e-5);
         assert!((relative * Vec3::Y - Vec3::Y).length() < 1e-5);
+    }
+
+    #[test]
+    fn swing_within_a_right_angle_matches_the_double_precision_arc() {
+        let twist = Quat::from_euler(glam::EulerRot::YXZ, 0.4, -1.2, 2.1);
+        let axis = Vec3::new(0.2, 1.0, -0.3).normalize();
+        let current = twist * axis;
+        let mut worst: f32 = 0.0;
+        for i in 0..2000 {
+            let angle = i as f32 * 0.37;
+            let turn = Quat::from_axis_angle(current.any_orthonormal_vector(), 1e-6 + 1.5707 * (i as f32 / 2000.0));
+            let target = (Quat::from_axis_angle(current, angle) * turn * current).normalize();
+            let fast = swing_to(twist, axis, target);
+            let reference = (shortest_arc(current, target) * twist).normalize();
+            assert!((fast * axis - target).length() < 1e-6, "{i}");
+            worst = worst.max(rotation_angle(fast.inverse() * reference));
+        }
+        assert!(worst < 1e-6, "{worst}");
     }
 
     #[test]

@@ -14,19 +14,20 @@ use glam::{Quat, Vec3};
 
 use super::scalar::{Quaternion, Vec, exp_series, length_squared, mul};
 use super::simd::{F, M3, Mask, Q, V3};
-use crate::core::polar::{CONVERGED_ANGLE, MAX_NEWTON_ANGLE, MIN_PIVOT};
+use crate::core::polar::{CONVERGED_ANGLE, LANDING_ANGLE, MAX_NEWTON_ANGLE, MIN_PIVOT};
 use crate::core::rod::POLAR_ITERATIONS;
 
 /// Columns.
 type Mat = [Vec; 3];
 
 /// Improves every lane's `q` towards the rotation part of its `a`; a lane stops changing once it has
-/// converged. Returns the rotation matrices of the final `q`.
+/// converged or its Newton step has landed. Returns the rotation matrices of the final `q`.
 #[inline(always)]
 pub fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>) -> M3<L> {
     let norm = (a.x_axis.length_squared() + a.y_axis.length_squared() + a.z_axis.length_squared()).sqrt();
     let guard = norm * 1e-9 + f32::MIN_POSITIVE;
     let mut active = [true; L];
+    let mut turning = [false; L];
     let mut steps = V3::ZERO;
     let mut next = *q;
     for _ in 0..POLAR_ITERATIONS {
@@ -45,22 +46,23 @@ pub fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>) -> M3<L> {
             let converged = length_squared(muller) < CONVERGED_ANGLE * CONVERGED_ANGLE;
             // `&` rather than `&&`: no branch in the loop body.
             let still = active[lane] & !converged;
-            active[lane] = still;
-            any_active |= still;
-            let step = newton_step(&s, g, trace, muller);
+            turning[lane] = still;
+            let (step, lands) = newton_step(&s, g, trace, muller);
+            active[lane] = still & !lands;
+            any_active |= active[lane];
             let (turn, far) = exp_series(step);
             any_far |= still & far;
             steps.set(lane, step);
             next.set(lane, mul(quat, turn));
         }
+        if any_far {
+            exact_turns(q, &steps, &turning, &mut next);
+        }
+        let renormalized = next.scale(F::splat(1.5) - next.dot(next) * 0.5);
+        *q = Q::select(Mask(turning), renormalized, *q);
         if !any_active {
             break;
         }
-        if any_far {
-            exact_turns(q, &steps, &active, &mut next);
-        }
-        let renormalized = next.scale(F::splat(1.5) - next.dot(next) * 0.5);
-        *q = Q::select(Mask(active), renormalized, *q);
     }
     M3::from_quat(*q)
 }
@@ -79,10 +81,11 @@ fn exact_turns<const L: usize>(q: &Q<L>, steps: &V3<L>, active: &[bool; L], next
     }
 }
 
-/// `polar::newton_step`, or the Müller step `muller` where the Newton step is not trusted. A mirror rather than
-/// a call: that one takes glam's SIMD `Mat3A` and returns an `Option`, and either keeps the lane loop scalar.
+/// `polar::newton_step`, or the Müller step `muller` where the Newton step is not trusted, and whether the step
+/// lands (`polar::LANDING_ANGLE`). A mirror rather than a call: that one takes glam's SIMD `Mat3A` and returns an
+/// `Option`, and either keeps the lane loop scalar.
 #[inline(always)]
-fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec) -> Vec {
+fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec) -> (Vec, bool) {
     let (h00, h11, h22) = (trace - s[0][0], trace - s[1][1], trace - s[2][2]);
     let h01 = (s[1][0] + s[0][1]) * -0.5;
     let h02 = (s[2][0] + s[0][2]) * -0.5;
@@ -102,8 +105,10 @@ fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec) -> Vec {
         (c01 * g[0] + c11 * g[1] + c12 * g[2]) * inv_det,
         (c02 * g[0] + c12 * g[1] + c22 * g[2]) * inv_det,
     ];
-    let short = length_squared(step) <= MAX_NEWTON_ANGLE * MAX_NEWTON_ANGLE;
-    if definite & short { step } else { muller }
+    let step_squared = length_squared(step);
+    let newton = definite & (step_squared <= MAX_NEWTON_ANGLE * MAX_NEWTON_ANGLE);
+    let lands = newton & (step_squared < LANDING_ANGLE * LANDING_ANGLE);
+    (if newton { step } else { muller }, lands)
 }
 
 /// `M3::from_quat`.

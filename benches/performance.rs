@@ -51,9 +51,12 @@ static ALLOCATOR: CountingAllocator = CountingAllocator;
 fn solver_path() -> String {
     const NEAR_COLLIDERS: &str = "contacts lane by lane in scalar code; the last 1 or 2 chains of a joint count after \
                                   its groups of 8 (too few for a group): scalar solver";
-    let lanes = "lane solver (chains of equal joint count in SIMD groups of 8 or 4)";
+    let lanes = "lane solver (chains of equal joint count in SIMD groups of 16, 8 or 4)";
     match kodawari::simd_path() {
-        "avx2" => format!("{lanes}, avx2 kernel chosen at run time; {NEAR_COLLIDERS}"),
+        "avx512" => format!(
+            "{lanes}, kernels chosen at run time: avx512 for groups of 16, avx2 for groups of 8 and 4; {NEAR_COLLIDERS}"
+        ),
+        "avx2" => format!("{lanes}, avx2 kernel chosen at run time (no AVX-512 here: no groups of 16); {NEAR_COLLIDERS}"),
         "sse2" => format!("{lanes}, sse2 kernel (the portable x86-64 copy: no AVX2 on this CPU); {NEAR_COLLIDERS}"),
         "scalar" => {
             format!("{lanes}, no SIMD instructions on this architecture (lanes in scalar code); {NEAR_COLLIDERS}")

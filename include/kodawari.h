@@ -589,8 +589,9 @@ uint32_t kdw_abi_version(void);
 // The library's version, e.g. "0.1.0": static, NUL-terminated, never NULL.
 const char *kdw_version_string(void);
 
-// The instruction set `KDW_SOLVER_LANES` runs its kernel with on this CPU: "avx2", "sse2" (the portable
-// x86-64 kernel), "neon" (aarch64) or "scalar" (no SIMD kernel for this architecture).
+// The instruction set `KDW_SOLVER_LANES` runs its kernel with on this CPU: "avx512" (groups of 16 chains in
+// 512-bit registers, smaller groups with AVX2), "avx2", "sse2" (the portable x86-64 kernel), "neon" (aarch64)
+// or "scalar" (no SIMD kernel for this architecture).
 // `KDW_SOLVER_LANES_PORTABLE` always runs the portable kernel. Static, NUL-terminated, never NULL.
 const char *kdw_simd_path(void);
 

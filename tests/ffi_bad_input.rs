@@ -2337,7 +2337,7 @@ fn constant_queries() {
     assert_eq!(version, env!("CARGO_PKG_VERSION"));
     // SAFETY: static NUL-terminated string.
     let simd = unsafe { CStr::from_ptr(kdw_simd_path()) }.to_str().unwrap();
-    assert!(["avx2", "sse2", "neon", "scalar"].contains(&simd), "kdw_simd_path() = {simd:?}");
+    assert!(["avx512", "avx2", "sse2", "neon", "scalar"].contains(&simd), "kdw_simd_path() = {simd:?}");
     assert_eq!(simd, kodawari::simd_path());
     assert_eq!(kdw_engine_def_default().struct_size as usize, size_of::<kdw_engine_def>());
     assert_eq!(kdw_chain_def_default().struct_size as usize, size_of::<kdw_chain_def>());

@@ -67,7 +67,7 @@ inline uint32_t abiVersion() noexcept { return kdw_abi_version(); }
 /// The library's version string, e.g. "0.1.0".
 inline const char* versionString() noexcept { return kdw_version_string(); }
 
-/// The instruction set the lane solver's kernel runs with on this CPU: "avx2", "sse2" (the portable
+/// The instruction set the lane solver's kernel runs with on this CPU: "avx512", "avx2", "sse2" (the portable
 /// x86-64 kernel), "neon" or "scalar". Static, never null.
 inline const char* simdPath() noexcept { return kdw_simd_path(); }
 

@@ -413,8 +413,9 @@ namespace Kodawari.Native
         internal static extern byte* kdw_version_string();
 
         /// <summary>
-        ///  The instruction set `KDW_SOLVER_LANES` runs its kernel with on this CPU: "avx2", "sse2" (the portable
-        ///  x86-64 kernel), "neon" (aarch64) or "scalar" (no SIMD kernel for this architecture).
+        ///  The instruction set `KDW_SOLVER_LANES` runs its kernel with on this CPU: "avx512" (groups of 16 chains in
+        ///  512-bit registers, smaller groups with AVX2), "avx2", "sse2" (the portable x86-64 kernel), "neon" (aarch64)
+        ///  or "scalar" (no SIMD kernel for this architecture).
         ///  `KDW_SOLVER_LANES_PORTABLE` always runs the portable kernel. Static, NUL-terminated, never NULL.
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_simd_path", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]

@@ -20,8 +20,9 @@ pub extern "C" fn kdw_version_string() -> *const c_char {
     concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
 }
 
-/// The instruction set `KDW_SOLVER_LANES` runs its kernel with on this CPU: "avx2", "sse2" (the portable
-/// x86-64 kernel), "neon" (aarch64) or "scalar" (no SIMD kernel for this architecture).
+/// The instruction set `KDW_SOLVER_LANES` runs its kernel with on this CPU: "avx512" (groups of 16 chains in
+/// 512-bit registers, smaller groups with AVX2), "avx2", "sse2" (the portable x86-64 kernel), "neon" (aarch64)
+/// or "scalar" (no SIMD kernel for this architecture).
 /// `KDW_SOLVER_LANES_PORTABLE` always runs the portable kernel. Static, NUL-terminated, never NULL.
 #[unsafe(no_mangle)]
 pub extern "C" fn kdw_simd_path() -> *const c_char {

@@ -108,7 +108,7 @@ void test_defaults_and_versions() {
     CHECK(kodawari::abiVersion() == KDW_ABI_VERSION);
     CHECK(std::string(kodawari::versionString()).size() > 0);
     const std::string simd = kodawari::simdPath();
-    CHECK(simd == "avx2" || simd == "sse2" || simd == "neon" || simd == "scalar");
+    CHECK(simd == "avx512" || simd == "avx2" || simd == "sse2" || simd == "neon" || simd == "scalar");
     CHECK(std::string(kodawari::statusString(KDW_STATUS_INVALID_ID)) == kdw_status_str(KDW_STATUS_INVALID_ID));
 }
 

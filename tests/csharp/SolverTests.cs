@@ -67,7 +67,7 @@ static unsafe class SolverTests
     public static void SolverSelection()
     {
         string simd = Library.SimdPath;
-        Ensure(simd == "avx2" || simd == "sse2" || simd == "neon" || simd == "scalar", "SIMD path " + simd);
+        Ensure(simd == "avx512" || simd == "avx2" || simd == "sse2" || simd == "neon" || simd == "scalar", "SIMD path " + simd);
         Ensure(ReferenceEquals(simd, Library.SimdPath), "SIMD path read once");
 
         var solvers = new[] { Solver.Lanes, Solver.LanesPortable, Solver.Scalar };

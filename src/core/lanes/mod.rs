@@ -2,17 +2,18 @@
 //!
 //! Most chains of a character are alike (a head of hair: dozens of strands of one length), and the scalar
 //! solver leaves most of a modern CPU's vector width unused. Here a step sorts the chains it simulates by
-//! joint count (and limp or not), cuts each run of equal length into groups of 8 and 4 chains (the last group
-//! of a run may repeat one of its chains in its spare lanes), and advances each group through all of the
-//! step's substeps in structure-of-arrays buffers. The last 1 or 2 chains of a run after its groups of 8,
+//! joint count (and limp or not), cuts each run of equal length into groups of 16 (on CPUs with AVX-512), 8
+//! and 4 chains (the last group of a run may repeat one of its chains in its spare lanes), and advances each
+//! group through all of the step's substeps in structure-of-arrays buffers. The last 1 or 2 chains of a run after its groups of 8,
 //! too few for a group to pay, take the scalar solver.
 //!
 //! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group, whose phases are compiled one by one;
 //!   [`polar`], [`lengths`] and [`rotations`]: the parts written as loops over lanes, with one lane's
 //!   arithmetic in [`scalar`]; [`contacts`]: the contact pass, lane by lane; [`group`]: the buffers.
-//! - The wide copies of the kernel are compiled for AVX2 next to the portable (SSE2) one and chosen at run
-//!   time by CPU-feature detection ([`multiversion`]); no build needs `target-cpu=native`.
-//! - Determinism: a chain's result does not depend on its lane, on the group it shares (8 or 4 wide), or on
+//! - The wide copies of the kernel are compiled for AVX2 (groups of 8 and 4) and AVX-512 (groups of 16) next
+//!   to the portable (SSE2) one and chosen at run time by CPU-feature detection ([`multiversion`]); no build
+//!   needs `target-cpu=native`.
+//! - Determinism: a chain's result does not depend on its lane, on the group it shares (16, 8 or 4 wide), or on
 //!   which copy of the kernel ran (no fused or reordered floating-point operations): the same bits on every
 //!   x86-64 and aarch64 CPU. It differs from the scalar solver ([`Solver::Scalar`]) by float rounding only
 //!   (the two implement the same operations, grouped differently); `tests/lanes.rs` and the accuracy report
@@ -58,12 +59,19 @@ pub enum Solver {
     Scalar,
 }
 
-/// The instruction set the lane solver's kernel runs with on this CPU: `"avx2"`, `"sse2"` (the portable
-/// x86-64 build), `"neon"` (aarch64) or `"scalar"`.
+/// The instruction set the lane solver's kernel runs with on this CPU: `"avx512"` (groups of 16 in 512-bit
+/// registers, groups of 8 and 4 with AVX2), `"avx2"`, `"sse2"` (the portable x86-64 build), `"neon"` (aarch64)
+/// or `"scalar"`.
 pub fn simd_path() -> &'static str {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::is_x86_feature_detected!("avx2") { "avx2" } else { "sse2" }
+        if has_avx512() {
+            "avx512"
+        } else if std::is_x86_feature_detected!("avx2") {
+            "avx2"
+        } else {
+            "sse2"
+        }
     }
     #[cfg(target_arch = "aarch64")]
     {
@@ -72,6 +80,21 @@ pub fn simd_path() -> &'static str {
     #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
     {
         "scalar"
+    }
+}
+
+/// Whether this CPU runs the 16-lane kernel (`WIDE16`'s instruction sets; the detection is cached by `std`).
+fn has_avx512() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx512f")
+            && std::is_x86_feature_detected!("avx512vl")
+            && std::is_x86_feature_detected!("avx512bw")
+            && std::is_x86_feature_detected!("avx512dq")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
     }
 }
 
@@ -106,24 +129,33 @@ pub(crate) struct Clock<'a> {
 /// The lane solver's reusable buffers (one group of each width).
 #[derive(Default)]
 pub struct LaneSolver {
+    /// Used only where the CPU has AVX-512.
+    g16: LaneGroup<16>,
     g8: LaneGroup<8>,
     g4: LaneGroup<4>,
 }
 
-/// How a run of `len` chains of one kind is cut into lane groups: full groups of 8, then the rest as one
-/// group of 8 or 4 whose spare lanes repeat a chain of the group (computed, never stored), or on the scalar
-/// solver. Measured in instructions (callgrind, `step_cost 4 16 100 sway` on both solvers and `8 16 100`): a
-/// group of 4 costs 2.0x less than 4 chains on the scalar solver (39.1M against 79.0M) and a group of 8 1.33x
-/// as much as a group of 4 (51.8M), so 5-7 chains are cheapest as a padded group of 8, 3 as a padded group of 4, and 1-2 on the scalar
-/// solver (a group of 4 holding 2 costs what they cost there).
-fn group_widths(len: usize) -> impl Iterator<Item = (usize, usize)> {
-    let full = len / 8;
-    let tail = match len % 8 {
+/// How a run of `len` chains of one kind is cut into lane groups: full groups of 16 where the CPU has AVX-512
+/// (`sixteen`), full groups of 8, then the rest as one group of 8 or 4 whose spare lanes repeat a chain of the
+/// group (computed, never stored), or on the scalar solver. Measured in instructions (callgrind, `step_cost 4
+/// 16 100 sway` on both solvers and `8 16 100`): a group of 4 costs 2.0x less than 4 chains on the scalar
+/// solver (39.1M against 79.0M) and a group of 8 1.33x as much as a group of 4 (51.8M), so 5-7 chains are
+/// cheapest as a padded group of 8, 3 as a padded group of 4, and 1-2 on the scalar solver (a group of 4
+/// holding 2 costs what they cost there). A group of 16 in 512-bit registers runs the same operations on
+/// twice the chains per instruction. The kernel is bound by the latency of its chains of dependent operations
+/// (shape matching goes root to tip), so that shortens its time per chain: 0.76x that of groups of 8 with
+/// AVX2 (median of 16 interleaved runs of `step_cost 1000 16 10 sway`). With AVX2 alone (two 256-bit halves
+/// per operation) groups of 16 were no faster than groups of 8.
+fn group_widths(len: usize, sixteen: bool) -> impl Iterator<Item = (usize, usize)> {
+    let sixteens = if sixteen { len / 16 } else { 0 };
+    let rest = len - 16 * sixteens;
+    let full = rest / 8;
+    let tail = match rest % 8 {
         rest @ 5..=7 => Some((rest, 8)),
         rest @ 3..=4 => Some((rest, 4)),
         _ => None,
     };
-    std::iter::repeat_n((8, 8), full).chain(tail)
+    std::iter::repeat_n((16, 16), sixteens).chain(std::iter::repeat_n((8, 8), full)).chain(tail)
 }
 
 impl LaneSolver {
@@ -141,13 +173,14 @@ impl LaneSolver {
         portable: bool,
     ) -> (u64, u64) {
         jobs.sort_unstable_by_key(|j| (j.key(), j.slot));
+        let sixteen = !portable && has_avx512();
         leftovers.clear();
         let mut kept = 0;
         let mut first = 0;
         while first < jobs.len() {
             let key = jobs[first].key();
             let len = jobs[first..].iter().take_while(|j| j.key() == key).count();
-            let grouped: usize = group_widths(len).map(|(chains, _)| chains).sum();
+            let grouped: usize = group_widths(len, sixteen).map(|(chains, _)| chains).sum();
             for i in first..first + len {
                 if i - first < grouped {
                     jobs[kept] = jobs[i];
@@ -165,10 +198,11 @@ impl LaneSolver {
             let same = rest.iter().take_while(|j| j.key() == first.key()).count();
             let (mut run, tail) = rest.split_at(same);
             rest = tail;
-            for (count, width) in group_widths(same) {
+            for (count, width) in group_widths(same, sixteen) {
                 let (group, remaining) = run.split_at(count);
                 run = remaining;
                 let (group_fallbacks, group_pairs) = match (width, portable) {
+                    (16, _) => run_group(&mut self.g16, chains, group, clock, reach, &WIDE16),
                     (8, false) => run_group(&mut self.g8, chains, group, clock, reach, &WIDE8),
                     (8, true) => run_group(&mut self.g8, chains, group, clock, reach, &Phases::PORTABLE),
                     (_, false) => run_group(&mut self.g4, chains, group, clock, reach, &WIDE4),
@@ -182,40 +216,40 @@ impl LaneSolver {
     }
 }
 
-/// The kernel's phases compiled with AVX2 where the CPU has it, one dispatching function per phase and width.
+/// The kernel's phases compiled for `$target` where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident) => {
-        #[multiversion(targets("x86_64+avx2"))]
+    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident) => {
+        #[multiversion(targets($target))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
             kernel::begin_substep(g, s, $predict)
         }
 
-        #[multiversion(targets("x86_64+avx2"))]
+        #[multiversion(targets($target))]
         fn $predict(w: &[V3<$lanes>], q: &[Q<$lanes>], qp: &mut [Q<$lanes>], h: f32) {
             rotations::predict_orientations(w, q, qp, h)
         }
 
-        #[multiversion(targets("x86_64+avx2"))]
+        #[multiversion(targets($target))]
         fn $spin(qp: &[Q<$lanes>], q: &[Q<$lanes>], w: &mut [V3<$lanes>], inv_h: f32) {
             rotations::angular_velocities(qp, q, w, inv_h)
         }
 
-        #[multiversion(targets("x86_64+avx2"))]
+        #[multiversion(targets($target))]
         fn $match_shape(g: &mut LaneGroup<$lanes>) {
             kernel::match_shape(g, $polar)
         }
 
-        #[multiversion(targets("x86_64+avx2"))]
+        #[multiversion(targets($target))]
         fn $polar(a: &M3<$lanes>, q: &mut Q<$lanes>) -> M3<$lanes> {
             polar::extract_rotation(a, q)
         }
 
-        #[multiversion(targets("x86_64+avx2"))]
+        #[multiversion(targets($target))]
         fn $solve(g: &mut LaneGroup<$lanes>, lanes: Mask<$lanes>) -> Mask<$lanes> {
             lengths::solve_lengths(g, lanes, &$passes)
         }
 
-        #[multiversion(targets("x86_64+avx2"))]
+        #[multiversion(targets($target))]
         fn $first(
             p: &[DV3<$lanes>],
             d: &[DV3<$lanes>],
@@ -229,7 +263,7 @@ macro_rules! wide_phases {
         }
 
         #[allow(clippy::too_many_arguments)]
-        #[multiversion(targets("x86_64+avx2"))]
+        #[multiversion(targets($target))]
         fn $corrected(
             p: &[DV3<$lanes>],
             corrected: &mut [DV3<$lanes>],
@@ -246,7 +280,7 @@ macro_rules! wide_phases {
 
         const $passes: Passes<$lanes> = Passes { first: $first, corrected: $corrected };
 
-        #[multiversion(targets("x86_64+avx2"))]
+        #[multiversion(targets($target))]
         fn $finish(g: &mut LaneGroup<$lanes>) {
             kernel::finish_substep(g, $spin)
         }
@@ -259,6 +293,7 @@ macro_rules! wide_phases {
 wide_phases!(
     WIDE8,
     8,
+    "x86_64+avx2",
     begin8,
     match_shape8,
     polar8,
@@ -271,8 +306,24 @@ wide_phases!(
     spin8
 );
 wide_phases!(
+    WIDE16,
+    16,
+    "x86_64+avx512f+avx512vl+avx512bw+avx512dq",
+    begin16,
+    match_shape16,
+    polar16,
+    solve_lengths16,
+    PASSES16,
+    first_pass16,
+    corrected_pass16,
+    finish16,
+    predict16,
+    spin16
+);
+wide_phases!(
     WIDE4,
     4,
+    "x86_64+avx2",
     begin4,
     match_shape4,
     polar4,
@@ -364,4 +415,28 @@ fn run_group<const L: usize>(
         chain.half_kick = false;
     }
     (fallbacks, pairs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::group_widths;
+
+    #[test]
+    fn runs_are_cut_into_groups_of_16_only_where_the_kernel_has_them() {
+        let cut = |len, sixteen| group_widths(len, sixteen).collect::<Vec<_>>();
+        assert_eq!(cut(2, true), []);
+        assert_eq!(cut(16, false), [(8, 8), (8, 8)]);
+        assert_eq!(cut(16, true), [(16, 16)]);
+        assert_eq!(cut(29, true), [(16, 16), (8, 8), (5, 8)]);
+        assert_eq!(cut(35, true), [(16, 16), (16, 16), (3, 4)]);
+        assert_eq!(cut(18, true), [(16, 16)]);
+        for len in 0..100 {
+            for sixteen in [false, true] {
+                let groups = cut(len, sixteen);
+                let grouped: usize = groups.iter().map(|&(chains, _)| chains).sum();
+                assert!(len - grouped <= 2, "{len}: at most 2 left for the scalar solver");
+                assert!(groups.iter().all(|&(chains, width)| chains <= width && (sixteen || width < 16)));
+            }
+        }
+    }
 }

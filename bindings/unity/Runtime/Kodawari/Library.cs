@@ -25,7 +25,7 @@ namespace Kodawari
 
         static string simdPath;
 
-        /// <summary>The instruction set the lane solver's kernel runs with on this CPU: "avx2", "sse2" (the portable
+        /// <summary>The instruction set the lane solver's kernel runs with on this CPU: "avx512", "avx2", "sse2" (the portable
         /// x86-64 kernel), "neon" or "scalar". Read once, then cached.</summary>
         public static string SimdPath
         {

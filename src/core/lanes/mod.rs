@@ -2,10 +2,10 @@
 //!
 //! Most chains of a character are alike (a head of hair: dozens of strands of one length), and the scalar
 //! solver leaves most of a modern CPU's vector width unused. Here a step sorts the chains it simulates by
-//! joint count (and limp or not), cuts each run of equal length into groups of 16 (on CPUs with AVX-512), 8
-//! and 4 chains (the last group of a run may repeat one of its chains in its spare lanes), and advances each
-//! group through all of the step's substeps in structure-of-arrays buffers. The last 1 or 2 chains of a run after its groups of 8,
-//! too few for a group to pay, take the scalar solver.
+//! joint count (and limp or not), cuts each run of equal length into groups of 16 (on CPUs with AVX-512:
+//! `has_avx512`), 8 and 4 chains (the last group of a run may repeat one of its chains in its spare lanes),
+//! and advances each group through all of the step's substeps in structure-of-arrays buffers. The last 1 or
+//! 2 chains of a run after its groups of 8, too few for a group to pay, take the scalar solver.
 //!
 //! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group, whose phases are compiled one by one;
 //!   [`polar`], [`lengths`] and [`rotations`]: the parts written as loops over lanes, with one lane's
@@ -83,14 +83,28 @@ pub fn simd_path() -> &'static str {
     }
 }
 
-/// Whether this CPU runs the 16-lane kernel (`WIDE16`'s instruction sets; the detection is cached by `std`).
+/// Whether this CPU runs the 16-lane kernel: `WIDE16`'s target, whose features are these. `multiversion` adds
+/// the Ice Lake generation's AVX-512 extensions to any AVX-512 target (so that CPUs whose 512-bit code runs at
+/// a lowered clock keep the AVX2 copy), and dispatches to the portable copy where one is missing; groups of 16
+/// must not run there. (`std` caches the detection.)
 fn has_avx512() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        std::is_x86_feature_detected!("avx512f")
-            && std::is_x86_feature_detected!("avx512vl")
-            && std::is_x86_feature_detected!("avx512bw")
-            && std::is_x86_feature_detected!("avx512dq")
+        use std::arch::is_x86_feature_detected as has;
+        has!("avx512f")
+            && has!("avx512vl")
+            && has!("avx512bw")
+            && has!("avx512dq")
+            && has!("avx512cd")
+            && has!("avx512ifma")
+            && has!("avx512vbmi")
+            && has!("avx512vbmi2")
+            && has!("avx512vnni")
+            && has!("avx512bitalg")
+            && has!("avx512vpopcntdq")
+            && has!("gfni")
+            && has!("vaes")
+            && has!("vpclmulqdq")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
@@ -308,7 +322,8 @@ wide_phases!(
 wide_phases!(
     WIDE16,
     16,
-    "x86_64+avx512f+avx512vl+avx512bw+avx512dq",
+    // Spelled out as `multiversion` completes it (see `has_avx512`).
+    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq",
     begin16,
     match_shape16,
     polar16,

@@ -153,41 +153,51 @@ impl<const L: usize> LaneGroup<L> {
         self.segment_bounds.reserve(n);
     }
 
-    /// Loads one chain into `lane`.
-    pub(crate) fn load(&mut self, lane: usize, chain: &LaneChain<'_>) {
+    /// Loads `chains[lane]` into every lane. Joint by joint across the lanes: the buffers of one joint (a few
+    /// cache lines per quantity) are written by every lane before the next joint's, where lane by lane every
+    /// lane would write all of the group's buffers, more than the L1 cache holds at 16 lanes.
+    pub(crate) fn load(&mut self, chains: &[LaneChain<'_>; L]) {
         let n = self.n;
-        let st = chain.state;
-        debug_assert_eq!(st.x.len(), n);
         for j in 0..n {
-            self.x[j].set(lane, st.x[j].to_array());
-            self.v[j].set(lane, st.v[j].to_array());
-            self.q[j].set(lane, st.q[j].to_array());
-            self.w[j].set(lane, st.w[j].to_array());
-            self.group_rotation[j].set(lane, st.group_rotation[j].to_array());
-            let qbar = chain.rest.orientations[j];
-            self.qbar[j].set(lane, qbar.to_array());
-            self.qbar_inv[j].set(lane, qbar.inverse().to_array());
-            let [a, b, c] = chain.offsets[j];
-            let offsets = &mut self.offsets[j];
-            offsets[0].set(lane, a.to_array());
-            offsets[1].set(lane, b.to_array());
-            offsets[2].set(lane, c.to_array());
+            for (lane, chain) in chains.iter().enumerate() {
+                let st = chain.state;
+                self.x[j].set(lane, st.x[j].to_array());
+                self.v[j].set(lane, st.v[j].to_array());
+                self.q[j].set(lane, st.q[j].to_array());
+                self.w[j].set(lane, st.w[j].to_array());
+                self.group_rotation[j].set(lane, st.group_rotation[j].to_array());
+            }
+            for (lane, chain) in chains.iter().enumerate() {
+                let qbar = chain.rest.orientations[j];
+                self.qbar[j].set(lane, qbar.to_array());
+                self.qbar_inv[j].set(lane, qbar.inverse().to_array());
+                let [a, b, c] = chain.offsets[j];
+                let offsets = &mut self.offsets[j];
+                offsets[0].set(lane, a.to_array());
+                offsets[1].set(lane, b.to_array());
+                offsets[2].set(lane, c.to_array());
+            }
         }
-        self.rest_root.set(lane, chain.rest.positions[0].to_array());
         for k in 0..n - 1 {
-            let l = chain.lengths[k];
-            let l2 = l as f64 * l as f64;
-            self.lengths[k].0[lane] = l;
-            self.length_squared[k].0[lane] = l2;
-            self.inverse_length_squared[k].0[lane] = 1.0 / l2;
+            for (lane, chain) in chains.iter().enumerate() {
+                let l = chain.lengths[k];
+                let l2 = l as f64 * l as f64;
+                self.lengths[k].0[lane] = l;
+                self.length_squared[k].0[lane] = l2;
+                self.inverse_length_squared[k].0[lane] = 1.0 / l2;
+            }
         }
-        let constants = chain.constants;
-        self.alpha.0[lane] = constants.alpha_per_iteration;
-        self.decay.0[lane] = constants.velocity_decay;
-        self.gravity.set(lane, constants.gravity.to_array());
-        self.orientation_weight.0[lane] = constants.orientation_weight;
-        self.half_kick.0[lane] = chain.half_kick;
-        self.memories[lane].copy_from(&st.solve_memory);
+        for (lane, chain) in chains.iter().enumerate() {
+            debug_assert_eq!(chain.state.x.len(), n);
+            self.rest_root.set(lane, chain.rest.positions[0].to_array());
+            let constants = chain.constants;
+            self.alpha.0[lane] = constants.alpha_per_iteration;
+            self.decay.0[lane] = constants.velocity_decay;
+            self.gravity.set(lane, constants.gravity.to_array());
+            self.orientation_weight.0[lane] = constants.orientation_weight;
+            self.half_kick.0[lane] = chain.half_kick;
+            self.memories[lane].copy_from(&chain.state.solve_memory);
+        }
     }
 
     /// The contacts of `lane` this step: `find` writes the colliders its chain can touch (indices in collider

@@ -372,21 +372,23 @@ fn run_group<const L: usize>(
         substeps,
     });
     let anchor = |job: &LaneJob, s: usize| job.start.interpolate(&job.target, clock.progress[s]);
+    let job_at = |lane: usize| jobs.get(lane).unwrap_or(first);
+    g.load(&std::array::from_fn(|lane| {
+        let job = job_at(lane);
+        let chain = chains.at(job.slot as usize).expect("live");
+        LaneChain {
+            state: &chain.state,
+            rest: &chain.rest,
+            offsets: &chain.rest_groups.offsets,
+            lengths: &chain.frame.lengths,
+            constants: &job.constants,
+            half_kick: chain.half_kick,
+        }
+    }));
     for lane in 0..L {
         let real = lane < jobs.len();
-        let job = if real { &jobs[lane] } else { first };
+        let job = job_at(lane);
         let chain = chains.at(job.slot as usize).expect("live");
-        g.load(
-            lane,
-            &LaneChain {
-                state: &chain.state,
-                rest: &chain.rest,
-                offsets: &chain.rest_groups.offsets,
-                lengths: &chain.frame.lengths,
-                constants: &job.constants,
-                half_kick: chain.half_kick,
-            },
-        );
         for s in 0..substeps {
             g.set_anchor(s, lane, &anchor(job, s));
         }

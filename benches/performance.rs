@@ -56,7 +56,9 @@ fn solver_path() -> String {
         "avx512" => format!(
             "{lanes}, kernels chosen at run time: avx512 for groups of 16, avx2 for groups of 8 and 4; {NEAR_COLLIDERS}"
         ),
-        "avx2" => format!("{lanes}, avx2 kernel chosen at run time (no AVX-512 here: no groups of 16); {NEAR_COLLIDERS}"),
+        "avx2" => {
+            format!("{lanes}, avx2 kernel chosen at run time (no AVX-512 here: no groups of 16); {NEAR_COLLIDERS}")
+        }
         "sse2" => format!("{lanes}, sse2 kernel (the portable x86-64 copy: no AVX2 on this CPU); {NEAR_COLLIDERS}"),
         "scalar" => {
             format!("{lanes}, no SIMD instructions on this architecture (lanes in scalar code); {NEAR_COLLIDERS}")

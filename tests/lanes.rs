@@ -204,7 +204,11 @@ fn a_chains_motion_does_not_depend_on_its_lane_or_group() {
         let mut strands: Vec<Strand> = (0..count)
             .map(|i| Strand {
                 joints: 10,
-                params: ChainParams { stiffness: 0.2 + 0.05 * (i % 12) as f32, damping: i as f32, ..Default::default() },
+                params: ChainParams {
+                    stiffness: 0.2 + 0.05 * (i % 12) as f32,
+                    damping: i as f32,
+                    ..Default::default()
+                },
                 views: i % 3 == 0,
             })
             .collect();

@@ -33,7 +33,7 @@ pub struct Chain {
     pub(crate) frame: ShapeFrame,
     base: EncodedShape,
     /// Each joint's bone axis in its own frame (from the base shape); the tip repeats its parent's.
-    bone_axes: Vec<Vec3>,
+    pub(crate) bone_axes: Vec<Vec3>,
     pub(crate) views: Vec<ViewShape>,
     weights: Vec<f32>,
     /// The base shape's weight in the last blend.
@@ -320,30 +320,24 @@ impl Chain {
     /// the interpolated segment directions with the exact segment lengths: interpolating positions directly
     /// would shorten a fast-turning bone (by up to 2% at render rates that do not divide the substep rate).
     pub(crate) fn write_output(&mut self, t: f32) {
-        let n = self.joint_count();
-        for j in 0..n {
-            let (a, b) = (&self.local_previous[j], &self.local_current[j]);
-            self.output[j].rotation = nlerp_shorter(a.rotation, b.rotation, t);
-        }
-        self.output[0].position = self.local_previous[0].position.lerp(self.local_current[0].position, t);
-        for j in 0..n - 1 {
-            let before = self.local_previous[j + 1].position - self.local_previous[j].position;
-            let after = self.local_current[j + 1].position - self.local_current[j].position;
-            let blended = match (direction(before), direction(after)) {
-                (Some(a), Some(b)) => direction(a.lerp(b, t)).unwrap_or(b),
-                (_, Some(b)) => b,
-                (Some(a), None) => a,
-                (None, None) => self.bone_axes[j],
-            };
-            self.output[j + 1].position = self.output[j].position + blended * self.frame.lengths[j];
-            self.output[j].rotation = swing_to(self.output[j].rotation, self.bone_axes[j], blended);
-        }
+        let render = RenderInput {
+            previous: &self.local_previous,
+            current: &self.local_current,
+            bone_axes: &self.bone_axes,
+            lengths: &self.frame.lengths,
+        };
+        render.pose(t, &mut self.output);
     }
 
     /// After a step's substeps: the output pose for render time `after` seconds past the newest internal state
     /// (`h` the substep), and the way to sleep (`still`: nothing about the chain changed this step).
     pub(crate) fn finish_step(&mut self, still: bool, substeps: u64, h: f64, after: f64, settings: &EngineSettings) {
-        self.write_output((after / h) as f32);
+        self.write_output(output_fraction(h, after));
+        self.track_sleep(still, substeps, h, settings);
+    }
+
+    /// [`finish_step`](Self::finish_step) for a chain whose output the lane solver wrote: towards sleeping.
+    pub(crate) fn track_sleep(&mut self, still: bool, substeps: u64, h: f64, settings: &EngineSettings) {
         if settings.sleep_speed > 0.0 && substeps > 0 {
             if still && self.relative_speed() < settings.sleep_speed * settings.scale {
                 self.still_time += (substeps as f64 * h) as f32;
@@ -366,6 +360,45 @@ impl Chain {
     pub(crate) fn view_shape_index(&self, id: ViewShapeId) -> Option<usize> {
         self.views.iter().position(|v| v.id == id)
     }
+}
+
+/// What [`Chain::write_output`] interpolates: the last two captured poses (relative to the anchor), the bone
+/// axes and the segment lengths.
+pub(crate) struct RenderInput<'a> {
+    pub previous: &'a [Transform],
+    pub current: &'a [Transform],
+    pub bone_axes: &'a [Vec3],
+    pub lengths: &'a [f32],
+}
+
+impl RenderInput<'_> {
+    /// The pose at fraction `t` between the two, into `output` (see [`Chain::write_output`]).
+    pub(crate) fn pose(&self, t: f32, output: &mut [Transform]) {
+        let (previous, current) = (self.previous, self.current);
+        let n = output.len();
+        for j in 0..n {
+            output[j].rotation = nlerp_shorter(previous[j].rotation, current[j].rotation, t);
+        }
+        output[0].position = previous[0].position.lerp(current[0].position, t);
+        for j in 0..n - 1 {
+            let before = previous[j + 1].position - previous[j].position;
+            let after = current[j + 1].position - current[j].position;
+            let blended = match (direction(before), direction(after)) {
+                (Some(a), Some(b)) => direction(a.lerp(b, t)).unwrap_or(b),
+                (_, Some(b)) => b,
+                (Some(a), None) => a,
+                (None, None) => self.bone_axes[j],
+            };
+            output[j + 1].position = output[j].position + blended * self.lengths[j];
+            output[j].rotation = swing_to(output[j].rotation, self.bone_axes[j], blended);
+        }
+    }
+}
+
+/// Where the render pose lies between the last two internal states, for render time `after` seconds past the
+/// newest (`h` the substep).
+pub(crate) fn output_fraction(h: f64, after: f64) -> f32 {
+    (after / h) as f32
 }
 
 /// The two transforms are the same to the bit (unlike `==`, which takes `-0.0` for `0.0`): a pose stored under

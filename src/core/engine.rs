@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicU16, Ordering};
 use glam::{Quat, Vec3};
 
 use super::arena::{Arena, Id, Kind};
-use super::chain::{Chain, ViewShape, ViewShapeId, relative_rotation};
+use super::chain::{Chain, ViewShape, ViewShapeId, output_fraction, relative_rotation};
 use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderSweep};
 use super::collision::ContactInput;
 use super::error::{Error, Result};
@@ -714,7 +714,8 @@ impl Engine {
             chain.finish_step(still, substeps, h, after, &settings);
         }
         if !self.lane_jobs.is_empty() {
-            let clock = Clock { h: h as f32, iterations, progress: &self.progress };
+            let clock =
+                Clock { h: h as f32, iterations, progress: &self.progress, output_fraction: output_fraction(h, after) };
             let portable = self.solver == Solver::LanesPortable;
             let (lane_fallbacks, lane_pairs) = self.lanes.step(
                 &mut self.chains,
@@ -745,7 +746,11 @@ impl Engine {
                 fallbacks += chain_fallbacks;
                 contact_pairs += pairs;
             }
-            for job in self.lane_jobs.drain(..).chain(self.lane_leftovers.drain(..)) {
+            for job in self.lane_jobs.drain(..) {
+                let chain = self.chains.at_mut(job.slot as usize).expect("live");
+                chain.track_sleep(job.still, substeps, h, &settings);
+            }
+            for job in self.lane_leftovers.drain(..) {
                 let chain = self.chains.at_mut(job.slot as usize).expect("live");
                 chain.finish_step(job.still, substeps, h, after, &settings);
             }

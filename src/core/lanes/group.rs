@@ -21,6 +21,9 @@ pub(crate) struct LaneChain<'a> {
     pub lengths: &'a [f32],
     pub constants: &'a ChainConstants,
     pub half_kick: bool,
+    /// `Chain::local_current` (the previous pose of a step of one substep) and `Chain::bone_axes`.
+    pub local_current: &'a [Transform],
+    pub bone_axes: &'a [Vec3],
 }
 
 /// Settings every lane of a group shares.
@@ -40,6 +43,7 @@ pub struct LaneGroup<const L: usize> {
     pub(super) h: f32,
     pub(super) iterations: u32,
     pub(super) shape_matching: bool,
+    pub(super) substeps: usize,
     // Particle state.
     pub(super) x: Vec<DV3<L>>,
     pub(super) v: Vec<V3<L>>,
@@ -70,6 +74,11 @@ pub struct LaneGroup<const L: usize> {
     pub(super) mu: Vec<D<L>>,
     pub(super) c_prime: Vec<D<L>>,
     pub(super) d_prime: Vec<D<L>>,
+    // The render pose (`lanes::output`): positions and rotations relative to the anchor, and the bone axes.
+    pub(super) local_previous: Vec<(V3<L>, Q<L>)>,
+    pub(super) local_current: Vec<(V3<L>, Q<L>)>,
+    pub(super) output: Vec<(V3<L>, Q<L>)>,
+    pub(super) bone_axes: Vec<V3<L>>,
     /// Each lane's contacts this step, and the lanes that have any.
     pub(super) contacts: Vec<LaneContacts>,
     pub(super) contact_lanes: Mask<L>,
@@ -139,6 +148,11 @@ impl<const L: usize> LaneGroup<L> {
             fit(v, n, D([0.0; L]));
         }
         fit(&mut self.anchors, settings.substeps, (V3::ZERO, zero_q));
+        for v in [&mut self.local_previous, &mut self.local_current, &mut self.output] {
+            fit(v, n, (V3::ZERO, zero_q));
+        }
+        fit(&mut self.bone_axes, n, V3::ZERO);
+        self.substeps = settings.substeps;
         if self.contacts.len() < L {
             self.contacts.resize_with(L, LaneContacts::default);
         }
@@ -168,6 +182,7 @@ impl<const L: usize> LaneGroup<L> {
                 self.group_rotation[j].set(lane, st.group_rotation[j].to_array());
             }
             for (lane, chain) in chains.iter().enumerate() {
+                self.bone_axes[j].set(lane, chain.bone_axes[j].to_array());
                 let qbar = chain.rest.orientations[j];
                 self.qbar[j].set(lane, qbar.to_array());
                 self.qbar_inv[j].set(lane, qbar.inverse().to_array());
@@ -176,6 +191,16 @@ impl<const L: usize> LaneGroup<L> {
                 offsets[0].set(lane, a.to_array());
                 offsets[1].set(lane, b.to_array());
                 offsets[2].set(lane, c.to_array());
+            }
+        }
+        if self.substeps < 2 {
+            // The one capture of the step turns the chain's newest pose into the previous one.
+            for j in 0..n {
+                for (lane, chain) in chains.iter().enumerate() {
+                    let local = &chain.local_current[j];
+                    self.local_current[j].0.set(lane, local.position.to_array());
+                    self.local_current[j].1.set(lane, local.rotation.to_array());
+                }
             }
         }
         for k in 0..n - 1 {
@@ -246,22 +271,33 @@ impl<const L: usize> LaneGroup<L> {
         rotation.set(lane, anchor.rotation.to_array());
     }
 
-    /// Positions and orientations of `lane` into `state` (what the render capture reads).
-    pub(crate) fn store_pose(&self, lane: usize, state: &mut RodState) {
+    /// The particle state of `lane` into `state`.
+    pub(crate) fn store(&self, lane: usize, state: &mut RodState) {
         for j in 0..self.n {
             state.x[j] = DVec3::from_array(self.x[j].get(lane));
             state.q[j] = Quat::from_array(self.q[j].get(lane));
-        }
-    }
-
-    /// The whole particle state of `lane` into `state`.
-    pub(crate) fn store(&self, lane: usize, state: &mut RodState) {
-        self.store_pose(lane, state);
-        for j in 0..self.n {
             state.v[j] = Vec3::from_array(self.v[j].get(lane));
             state.w[j] = Vec3::from_array(self.w[j].get(lane));
             state.group_rotation[j] = Quat::from_array(self.group_rotation[j].get(lane));
         }
         state.solve_memory.copy_from(&self.memories[lane]);
+    }
+
+    /// The render poses of `lane` (`lanes::output`) into its chain's buffers.
+    pub(crate) fn store_render(
+        &self,
+        lane: usize,
+        previous: &mut [Transform],
+        current: &mut [Transform],
+        output: &mut [Transform],
+    ) {
+        let transform = |(position, rotation): &(V3<L>, Q<L>)| {
+            Transform::new(Vec3::from_array(position.get(lane)), Quat::from_array(rotation.get(lane)))
+        };
+        for j in 0..self.n {
+            previous[j] = transform(&self.local_previous[j]);
+            current[j] = transform(&self.local_current[j]);
+            output[j] = transform(&self.output[j]);
+        }
     }
 }

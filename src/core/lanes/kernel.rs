@@ -7,6 +7,7 @@
 use super::contacts;
 use super::group::LaneGroup;
 use super::lengths::{Passes, solve_lengths};
+use super::output;
 use super::rotations::{Predict, Spin, angular_velocities, predict_orientations};
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
 use crate::core::inextensible::{self, SolveMemory, Solved};
@@ -21,6 +22,9 @@ pub struct Phases<const L: usize> {
     pub match_shape: fn(&mut LaneGroup<L>),
     pub solve_lengths: fn(&mut LaneGroup<L>, Mask<L>) -> Mask<L>,
     pub finish: fn(&mut LaneGroup<L>),
+    /// The render pose: the capture after substep `s`, and the output at fraction `t` ([`output`]).
+    pub capture: fn(&mut LaneGroup<L>, usize),
+    pub output: fn(&mut LaneGroup<L>, f32),
 }
 
 impl<const L: usize> Phases<L> {
@@ -30,6 +34,8 @@ impl<const L: usize> Phases<L> {
         match_shape: |g| match_shape(g, super::polar::extract_rotation),
         solve_lengths: |g, lanes| solve_lengths(g, lanes, &Passes::PORTABLE),
         finish: |g| finish_substep(g, angular_velocities),
+        capture: output::capture,
+        output: output::write,
     };
 }
 

@@ -28,6 +28,7 @@ mod contacts;
 mod group;
 mod kernel;
 mod lengths;
+mod output;
 mod polar;
 mod rotations;
 mod scalar;
@@ -138,6 +139,8 @@ pub(crate) struct Clock<'a> {
     pub iterations: u32,
     /// Fraction of the step's anchor motion reached at the end of each substep.
     pub progress: &'a [f32],
+    /// Where the render pose lies between the last two internal states (`Chain::write_output`'s `t`).
+    pub output_fraction: f32,
 }
 
 /// The lane solver's reusable buffers (one group of each width).
@@ -232,7 +235,7 @@ impl LaneSolver {
 
 /// The kernel's phases compiled for `$target` where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident) => {
+    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
         #[multiversion(targets($target))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
             kernel::begin_substep(g, s, $predict)
@@ -299,8 +302,24 @@ macro_rules! wide_phases {
             kernel::finish_substep(g, $spin)
         }
 
-        const $name: Phases<$lanes> =
-            Phases { begin: $begin, match_shape: $match_shape, solve_lengths: $solve, finish: $finish };
+        #[multiversion(targets($target))]
+        fn $capture(g: &mut LaneGroup<$lanes>, s: usize) {
+            output::capture(g, s)
+        }
+
+        #[multiversion(targets($target))]
+        fn $output(g: &mut LaneGroup<$lanes>, t: f32) {
+            output::write(g, t)
+        }
+
+        const $name: Phases<$lanes> = Phases {
+            begin: $begin,
+            match_shape: $match_shape,
+            solve_lengths: $solve,
+            finish: $finish,
+            capture: $capture,
+            output: $output,
+        };
     };
 }
 
@@ -317,7 +336,9 @@ wide_phases!(
     corrected_pass8,
     finish8,
     predict8,
-    spin8
+    spin8,
+    capture8,
+    output8
 );
 wide_phases!(
     WIDE16,
@@ -333,7 +354,9 @@ wide_phases!(
     corrected_pass16,
     finish16,
     predict16,
-    spin16
+    spin16,
+    capture16,
+    output16
 );
 wide_phases!(
     WIDE4,
@@ -348,7 +371,9 @@ wide_phases!(
     corrected_pass4,
     finish4,
     predict4,
-    spin4
+    spin4,
+    capture4,
+    output4
 );
 
 /// Steps the chains of `jobs` (at most `L`) in `g`. Spare lanes repeat the first chain without its contacts;
@@ -383,6 +408,8 @@ fn run_group<const L: usize>(
             lengths: &chain.frame.lengths,
             constants: &job.constants,
             half_kick: chain.half_kick,
+            local_current: &chain.local_current,
+            bone_axes: &chain.bone_axes,
         }
     }));
     for lane in 0..L {
@@ -419,16 +446,14 @@ fn run_group<const L: usize>(
         fallbacks += fell_back.0[..jobs.len()].iter().filter(|&&f| f).count() as u64;
         // The render interpolation keeps the last two internal poses.
         if s + 2 >= substeps {
-            for (lane, job) in jobs.iter().enumerate() {
-                let chain = chains.at_mut(job.slot as usize).expect("live");
-                g.store_pose(lane, &mut chain.state);
-                chain.capture_local(&anchor(job, s));
-            }
+            (phases.capture)(g, s);
         }
     }
+    (phases.output)(g, clock.output_fraction);
     for (lane, job) in jobs.iter().enumerate() {
         let chain = chains.at_mut(job.slot as usize).expect("live");
         g.store(lane, &mut chain.state);
+        g.store_render(lane, &mut chain.local_previous, &mut chain.local_current, &mut chain.output);
         chain.half_kick = false;
     }
     (fallbacks, pairs)

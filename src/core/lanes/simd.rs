@@ -405,6 +405,12 @@ impl<const L: usize> Q<L> {
         Self { x: -self.x, y: -self.y, z: -self.z, w: -self.w }
     }
 
+    /// The inverse of a unit quaternion (glam's `inverse`).
+    #[inline(always)]
+    pub fn conjugate(self) -> Self {
+        Self { x: -self.x, y: -self.y, z: -self.z, w: self.w }
+    }
+
     #[inline(always)]
     pub fn normalize(self) -> Self {
         let inv = F::splat(1.0) / self.dot(self).sqrt();

@@ -49,12 +49,14 @@ struct NewtonScratch {
     d_prime: Vec<f64>,
     /// Positions under the current multipliers (one per particle).
     corrected: Vec<DVec3>,
+    /// The last Newton step of the multipliers.
+    step: Vec<f64>,
 }
 
 impl ConstraintScratch {
     pub fn reserve(&mut self, bonds: usize) {
-        let NewtonScratch { mu, c_prime, d_prime, corrected } = &mut self.newton;
-        for v in [&mut self.length_squared, &mut self.inverse_length_squared, mu, c_prime, d_prime] {
+        let NewtonScratch { mu, c_prime, d_prime, corrected, step } = &mut self.newton;
+        for v in [&mut self.length_squared, &mut self.inverse_length_squared, mu, c_prime, d_prime, step] {
             if v.len() < bonds {
                 v.resize(bonds, 0.0);
             }
@@ -277,7 +279,7 @@ fn project_relinearized(
     let m = d.len();
     let p = &mut p[..m + 1];
     let (l2, inv_l2) = (&length_squared[..m], &inverse_length_squared[..m]);
-    let (mu, c_prime, d_prime) = (&mut s.mu[..m], &mut s.c_prime[..m], &mut s.d_prime[..m]);
+    let (mu, c_prime, d_prime, step) = (&mut s.mu[..m], &mut s.c_prime[..m], &mut s.d_prime[..m], &mut s.step[..m]);
     let mut previous_worst = f64::INFINITY;
     let mut lost = f64::INFINITY;
     for iteration in 0..RELINEARIZED_ITERATIONS {
@@ -297,7 +299,7 @@ fn project_relinearized(
             return false;
         }
         previous_worst = pass.worst;
-        if !pass.pivots_usable() || !back_substitute(c_prime, d_prime, mu, Update::Replace) {
+        if !pass.pivots_usable() || !back_substitute(c_prime, d_prime, mu, step, Update::Replace) {
             return false;
         }
         for j in 1..=m {
@@ -326,7 +328,7 @@ fn newton_along_directions(
     let m = d.len();
     let p = &mut p[..m + 1];
     let (l2, inv_l2) = (&length_squared[..m], &inverse_length_squared[..m]);
-    let (mu, corrected) = (&mut s.mu[..m], &mut s.corrected[..m + 1]);
+    let (mu, corrected, step) = (&mut s.mu[..m], &mut s.corrected[..m + 1], &mut s.step[..m]);
     let (c_prime, d_prime) = (&mut s.c_prime[..m], &mut s.d_prime[..m]);
     let mut previous_worst = f64::INFINITY;
     for iteration in 0..MAX_NEWTON_ITERATIONS {
@@ -362,11 +364,42 @@ fn newton_along_directions(
             return false;
         }
         let update = if iteration == 0 { Update::Replace } else { Update::Add };
-        if !back_substitute(c_prime, d_prime, mu, update) {
+        if !back_substitute(c_prime, d_prime, mu, step, update) {
             return false;
+        }
+        if pass.worst <= LANDING_GATE && error_after_step(d, step, inv_l2) <= TOLERANCE {
+            // The pass that would confirm it computes these same positions.
+            for j in 1..=m {
+                p[j] += shift(d, mu, j);
+            }
+            return true;
         }
     }
     false
+}
+
+/// Errors above this are too large for one more step to land within [`TOLERANCE`], so the prediction is not
+/// computed (a step from a relative error `e` leaves about `e^2`).
+pub(crate) const LANDING_GATE: f64 = 1e-4;
+
+/// The largest relative bond error `|F_k| / l_k^2` after the multipliers' Newton step `step` along the
+/// directions `d`, exactly: each `F_k` is quadratic in the multipliers and the step zeroes its linear part,
+/// so what remains is `|Δb_k|^2`, the square of the bond's change. This is what the next pass would measure
+/// (up to its rounding), without the pass's elimination.
+#[inline]
+fn error_after_step(d: &[DVec3], step: &[f64], inv_l2: &[f64]) -> f64 {
+    let m = d.len();
+    let mut worst = 0.0f64;
+    let mut below = DVec3::ZERO;
+    for k in 0..m {
+        let above = if k + 1 < m { d[k] * step[k] - d[k + 1] * step[k + 1] } else { d[k] * step[k] };
+        let error = (above - below).length_squared() * inv_l2[k];
+        if error > worst {
+            worst = error;
+        }
+        below = above;
+    }
+    worst
 }
 
 /// How [`back_substitute`] writes its solution into the multipliers.
@@ -380,12 +413,13 @@ enum Update {
 /// `d_prime` and replaces `mu` with it or adds it. Returns `false` if the step is not finite (the fallback's
 /// exact projection then starts from no multiplier where they are not finite).
 #[inline]
-fn back_substitute(c_prime: &[f64], d_prime: &[f64], mu: &mut [f64], update: Update) -> bool {
+fn back_substitute(c_prime: &[f64], d_prime: &[f64], mu: &mut [f64], step: &mut [f64], update: Update) -> bool {
     // A non-finite entry makes every later one non-finite (`x - c * inf` is infinite or NaN, `0 * inf` NaN),
     // so checking the last is enough.
     let mut next = 0.0f64;
     for k in (0..mu.len()).rev() {
         next = d_prime[k] - c_prime[k] * next;
+        step[k] = next;
         match update {
             Update::Replace => mu[k] = next,
             Update::Add => mu[k] += next,
@@ -517,6 +551,36 @@ mod tests {
         assert!(solve(&x, &mut p, &lengths, &mut s));
         assert!(max_stretch(&p, &lengths) < 1e-6, "{}", max_stretch(&p, &lengths));
         assert_eq!(p[0], x[0]);
+    }
+
+    /// The direct solve ends on a step whose predicted error (`error_after_step`) is within the tolerance,
+    /// without measuring it: measured at the result, the error is indeed within it, and the prediction was
+    /// the error itself (a Newton step on these quadratic constraints leaves exactly the squared bond change).
+    #[test]
+    fn a_landed_step_meets_the_tolerance_it_predicted() {
+        let n = 16;
+        let x: Vec<DVec3> = (0..n).map(|i| DVec3::new(0.025 * i as f64, 0.01 * (0.4 * i as f64).sin(), 0.0)).collect();
+        let lengths: Vec<f32> = (0..n - 1).map(|k| (x[k + 1] - x[k]).length() as f32).collect();
+        let mut p: Vec<DVec3> = x
+            .iter()
+            .enumerate()
+            .map(|(i, v)| *v + DVec3::new(1e-3 * (i as f64).sqrt(), -2e-3 * (0.7 * i as f64).cos(), 1e-3))
+            .collect();
+        p[0] = x[0];
+        let mut s = ConstraintScratch::default();
+        prepare(&x, &lengths, &mut s);
+        let m = n - 1;
+        let (d, l2, inv_l2) =
+            (s.start_bonds[..m].to_vec(), s.length_squared[..m].to_vec(), s.inverse_length_squared[..m].to_vec());
+        let mut stepped = p.clone();
+        assert!(newton_along_directions(&mut stepped, &d, &l2, &inv_l2, &mut s.newton));
+        let measured = (0..m)
+            .map(|k| (((stepped[k + 1] - stepped[k]).length_squared() - l2[k]) * inv_l2[k]).abs())
+            .fold(0.0, f64::max);
+        let predicted = error_after_step(&d, &s.newton.step[..m], &inv_l2);
+        assert!(measured <= TOLERANCE, "{measured}");
+        assert!((measured - predicted).abs() <= 1e-14, "{measured} vs {predicted}");
+        assert!(predicted > 0.0);
     }
 
     #[test]

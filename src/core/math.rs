@@ -225,7 +225,10 @@ mod tests {
         let mut worst: f32 = 0.0;
         for i in 0..2000 {
             let angle = i as f32 * 0.37;
-            let turn = Quat::from_axis_angle(current.any_orthonormal_vector(), 1e-6 + 0.9999 * std::f32::consts::FRAC_PI_2 * (i as f32 / 2000.0));
+            let turn = Quat::from_axis_angle(
+                current.any_orthonormal_vector(),
+                1e-6 + 0.9999 * std::f32::consts::FRAC_PI_2 * (i as f32 / 2000.0),
+            );
             let target = (Quat::from_axis_angle(current, angle) * turn * current).normalize();
             let fast = swing_to(twist, axis, target);
             let reference = (shortest_arc(current, target) * twist).normalize();

@@ -72,6 +72,8 @@ pub struct LaneGroup<const L: usize> {
     pub(super) start_bonds: Vec<DV3<L>>,
     pub(super) corrected: Vec<DV3<L>>,
     pub(super) mu: Vec<D<L>>,
+    /// The direct solve's last Newton step of the multipliers.
+    pub(super) step: Vec<D<L>>,
     pub(super) c_prime: Vec<D<L>>,
     pub(super) d_prime: Vec<D<L>>,
     // The render pose (`lanes::output`): positions and rotations relative to the anchor, and the bone axes.
@@ -142,6 +144,7 @@ impl<const L: usize> LaneGroup<L> {
             &mut self.length_squared,
             &mut self.inverse_length_squared,
             &mut self.mu,
+            &mut self.step,
             &mut self.c_prime,
             &mut self.d_prime,
         ] {

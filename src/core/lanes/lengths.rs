@@ -8,7 +8,7 @@
 
 use super::group::LaneGroup;
 use super::simd::{D, DV3, Mask};
-use crate::core::inextensible::{MAX_NEWTON_ITERATIONS, MIN_PIVOT, STAGNATION_LIMIT, TOLERANCE};
+use crate::core::inextensible::{LANDING_GATE, MAX_NEWTON_ITERATIONS, MIN_PIVOT, STAGNATION_LIMIT, TOLERANCE};
 
 type DVec = [f64; 3];
 
@@ -72,15 +72,54 @@ pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, passe
         let mut next = D::splat(0.0);
         for k in (0..m).rev() {
             next = g.d_prime[k] - g.c_prime[k] * next;
+            g.step[k] = next;
             let updated = if iteration == 0 { next } else { g.mu[k] + next };
             g.mu[k] = D::select(active, updated, g.mu[k]);
         }
         active = active.and(next.is_finite());
+        // `inextensible::error_after_step`: lanes whose step lands within the tolerance take its positions
+        // without the pass that would confirm it.
+        let near = active.and(pass.worst.le(D::splat(LANDING_GATE)));
+        if near.any() {
+            let landed = near.and(error_after_step(g, m).le(D::splat(TOLERANCE)));
+            if landed.any() {
+                apply_multipliers(g, m, landed);
+                solved = solved.or(landed);
+                active = active.and(landed.not());
+            }
+        }
         if !active.any() {
             break;
         }
     }
     solved
+}
+
+/// `inextensible::error_after_step` on every lane, from `g.step`.
+#[inline(always)]
+fn error_after_step<const L: usize>(g: &LaneGroup<L>, m: usize) -> D<L> {
+    let d = &g.start_bonds[..m];
+    let mut worst = D::splat(0.0);
+    let mut below = DV3::ZERO;
+    for k in 0..m {
+        let own = d[k].scale(g.step[k]);
+        let above = if k + 1 < m { own - d[k + 1].scale(g.step[k + 1]) } else { own };
+        let error = (above - below).length_squared() * g.inverse_length_squared[k];
+        // As the scalar code: a NaN error is ignored here (its lane's step was not finite: not active).
+        worst = D::select(error.gt(worst), error, worst);
+        below = above;
+    }
+    worst
+}
+
+/// The positions under the multipliers on the lanes of `lanes`, as [`corrected_pass`] computes them.
+#[inline(always)]
+fn apply_multipliers<const L: usize>(g: &mut LaneGroup<L>, m: usize, lanes: Mask<L>) {
+    for k in 0..m {
+        let pulled = g.start_bonds[k].scale(g.mu[k]);
+        let shift = if k + 1 < m { pulled - g.start_bonds[k + 1].scale(g.mu[k + 1]) } else { pulled };
+        g.p[k + 1] = DV3::select(lanes, g.p[k + 1] + shift, g.p[k + 1]);
+    }
 }
 
 /// One pass root to tip: the bonds under the current multipliers (`corrected`; the bonds of `p` itself

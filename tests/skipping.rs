@@ -51,6 +51,14 @@ fn a_settled_chain_sleeps_where_it_would_rest() {
     settle(&mut sleeping, 1.0);
     assert_eq!(chain_world(&sleeping, a), pose, "a sleeping chain does not move");
     assert_eq!(sleeping.chain_kinetic_energy(a).unwrap(), 0.0);
+    // `read_world` copies a sleeping chain's stored pose: the same transforms as the visitor gives.
+    for engine in [&sleeping, &awake] {
+        let mut visited = Vec::new();
+        engine.for_each_world_transform(engine.joint_count(), |t| visited.push(t)).unwrap();
+        let mut read = vec![Transform::IDENTITY; engine.joint_count() + 2];
+        assert_eq!(engine.read_world(&mut read).unwrap(), engine.joint_count());
+        assert_eq!(read[..engine.joint_count()], visited[..]);
+    }
 }
 
 /// Anything that changes a chain's situation wakes it: its anchor, its parameters, the view when it has view

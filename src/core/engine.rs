@@ -323,11 +323,11 @@ impl Engine {
             )));
         }
         for (i, anchor) in anchors.clone().enumerate() {
-            validate_transform(&anchor).map_err(|e| Error::invalid_argument(format!("anchor {i}: {e}")))?;
+            check_transform(&anchor).map_err(|e| Error::invalid_argument(format!("anchor {i}: {e}")))?;
         }
         for (&slot, anchor) in self.order.iter().zip(anchors) {
             let chain = self.chains.at_mut(slot as usize).expect("order holds live chains");
-            let anchor = validate_transform(&anchor).expect("validated above");
+            let anchor = normalized_transform(&anchor);
             chain.anchor_pending = anchor;
             if !chain.placed && chain.params.anchor == AnchorSource::Own {
                 // Until its first step a new chain reads back in its rest shape under this anchor.
@@ -468,11 +468,11 @@ impl Engine {
             )));
         }
         for (i, t) in transforms.clone().enumerate() {
-            validate_transform(&t).map_err(|e| Error::invalid_argument(format!("collider transform {i}: {e}")))?;
+            check_transform(&t).map_err(|e| Error::invalid_argument(format!("collider transform {i}: {e}")))?;
         }
         for (&slot, t) in self.collider_order.iter().zip(transforms) {
             let collider = self.colliders.at_mut(slot as usize).expect("order holds live colliders");
-            collider.pending = validate_transform(&t).expect("validated above");
+            collider.pending = normalized_transform(&t);
         }
         Ok(())
     }
@@ -843,7 +843,14 @@ impl Engine {
 
     /// World transforms of every joint of every chain, in creation order. Returns how many were written.
     pub fn read_world(&self, out: &mut [Transform]) -> Result<usize> {
-        fill_slice(out, |capacity, f| self.for_each_world_transform(capacity, f))
+        self.check_capacity(out.len())?;
+        let mut written = 0;
+        for chain in self.chains_in_order() {
+            let joints = chain.joint_count();
+            chain.write_world(&mut out[written..written + joints]);
+            written += joints;
+        }
+        Ok(written)
     }
 
     /// Local rotations (see [`for_each_local_rotation`](Self::for_each_local_rotation)) into `out`.
@@ -1056,6 +1063,10 @@ fn check_chain_capacity(chain: &Chain, capacity: usize) -> Result<()> {
 }
 
 fn is_teleport(from: &Transform, to: &Transform, distance: f32, angle: f32) -> bool {
+    // An unmoved anchor (every sleeping chain's) never teleports; this skips the angle's arctangent.
+    if from == to {
+        return false;
+    }
     (to.position - from.position).length() > distance || rotation_angle(from.rotation.inverse() * to.rotation) > angle
 }
 
@@ -1080,15 +1091,29 @@ pub(crate) fn validate_step(dt: f32, camera: Vec3, view_reference: &Transform) -
 
 /// A transform from outside, checked and with its rotation normalised: finite, rotation not all zero.
 pub(crate) fn validate_transform(t: &Transform) -> Result<Transform> {
+    check_transform(t)?;
+    Ok(normalized_transform(t))
+}
+
+/// [`validate_transform`]'s checks alone: batches check every entry before they change anything, then
+/// normalise each once.
+fn check_transform(t: &Transform) -> Result<()> {
     if !t.is_finite() {
         return Err(Error::invalid_argument("non-finite position or rotation"));
     }
     if !within_world(t.position) {
         return Err(Error::invalid_argument(format!("position beyond +-{MAX_COORDINATE} m")));
     }
-    let rotation =
-        normalized_rotation(t.rotation).ok_or_else(|| Error::invalid_argument("null rotation quaternion"))?;
-    Ok(Transform::new(t.position, rotation))
+    // Finite, so `normalized_rotation` fails only on a rotation of zeros.
+    if t.rotation == Quat::from_xyzw(0.0, 0.0, 0.0, 0.0) {
+        return Err(Error::invalid_argument("null rotation quaternion"));
+    }
+    Ok(())
+}
+
+/// The transform of a [`check_transform`]ed `t`, its rotation normalised.
+fn normalized_transform(t: &Transform) -> Transform {
+    Transform::new(t.position, normalized_rotation(t.rotation).expect("checked: finite and not zero"))
 }
 
 fn validate_direction(d: Vec3) -> Result<Vec3> {

@@ -696,7 +696,8 @@ fn main() {
         std::fs::read_to_string("/proc/loadavg").map_or("unknown".into(), |s| s.trim().to_owned())
     ));
     let substeps = report.scene("1000x16", PLAIN.id).map_or(4.0, |r| r.substeps.max(1) as f64);
-    let bound = Bound::new(&machine, substeps);
+    let simd_lanes = if kodawari::simd_path() == "avx512" { 16.0 } else { 8.0 };
+    let bound = Bound::new(&machine, substeps, simd_lanes);
     let markdown = report.markdown(&machine, &solver_path(), &bound, started.elapsed());
     let complete = !report.scenes.iter().any(|r| r.missing.as_deref() == Some(FILTERED_OUT));
     let path = if complete { Path::new("docs/performance.md") } else { Path::new("target/performance-partial.md") };

@@ -275,8 +275,9 @@ pub struct Bound {
     pub bytes_per_joint_frame: f64,
     /// Seconds per joint per substep if the operations ran at the scalar peak.
     pub scalar_compute: Option<f64>,
-    /// Same for an 8-lane f32 SIMD path (AVX2) at its peak.
-    pub simd8_compute: Option<f64>,
+    /// Same for the f32 SIMD path that ran at its peak: `simd_lanes` lanes (16 with AVX-512, 8 with AVX2).
+    pub simd_compute: Option<f64>,
+    pub simd_lanes: f64,
     /// Seconds per joint per substep to stream the frame's bytes at the measured bandwidth.
     pub memory: f64,
 }
@@ -284,10 +285,9 @@ pub struct Bound {
 /// Scalar peak assumption: 4 floating-point operations per cycle (two multiply/FMA pipes and two add pipes,
 /// fusion not counted), as on current x86-64 and aarch64 cores.
 pub const SCALAR_OPERATIONS_PER_CYCLE: f64 = 4.0;
-pub const SIMD_LANES: f64 = 8.0;
-
 impl Bound {
-    pub fn new(machine: &Machine, substeps_per_frame: f64) -> Self {
+    /// `simd_lanes`: the lane count of the widest kernel the lane solver ran.
+    pub fn new(machine: &Machine, substeps_per_frame: f64, simd_lanes: f64) -> Self {
         let operations: f64 = SUBSTEP_OPERATIONS.iter().map(|(_, n)| n).sum();
         let bytes: f64 = FRAME_BYTES.iter().map(|(_, n)| n).sum();
         let scalar = machine.mhz.map(|mhz| operations / (SCALAR_OPERATIONS_PER_CYCLE * mhz * 1e6));
@@ -295,7 +295,8 @@ impl Bound {
             operations_per_joint_substep: operations,
             bytes_per_joint_frame: bytes,
             scalar_compute: scalar,
-            simd8_compute: scalar.map(|s| s / SIMD_LANES),
+            simd_compute: scalar.map(|s| s / simd_lanes),
+            simd_lanes,
             memory: bytes / substeps_per_frame / machine.bandwidth,
         }
     }
@@ -713,7 +714,7 @@ impl Report {
              | scalar solver (plain, scalar solver): measured / bound |\n|---|---|---|---|\n\
              | compute, scalar peak ({SCALAR_OPERATIONS_PER_CYCLE:.0} operations/cycle at the clock above) \
              | {} | {} | {} |\n\
-             | compute, 8-lane f32 SIMD peak | {} | {} | - |\n\
+             | compute, {:.0}-lane f32 SIMD peak (the widest kernel that ran) | {} | {} | - |\n\
              | memory, measured stream bandwidth | {} | {} | {} |\n\n\
              Measured (1000 x 16): lane solver (the default; the plain variant) {} ns/joint/substep, scalar solver \
              {} ns/joint/substep. The lane solver is bounded by the SIMD line, the scalar solver by the scalar one. \
@@ -722,8 +723,9 @@ impl Report {
             ns_of(bound.scalar_compute),
             ratio(measured, bound.scalar_compute),
             ratio(measured_scalar, bound.scalar_compute),
-            ns_of(bound.simd8_compute),
-            ratio(measured, bound.simd8_compute),
+            bound.simd_lanes,
+            ns_of(bound.simd_compute),
+            ratio(measured, bound.simd_compute),
             ns_of(Some(bound.memory)),
             ratio(measured, Some(bound.memory)),
             ratio(measured_scalar, Some(bound.memory)),

@@ -75,7 +75,7 @@ inline const char* simdPath() noexcept { return kdw_simd_path(); }
 /// rounding; a chain's bits never depend on its lane, its group or the kernel copy.
 enum class Solver : uint32_t {
     /// Chains of equal joint count side by side in SIMD lanes (the default; contacts lane by lane). The last 1
-    /// or 2 chains of a joint count after its groups of 8 (too few for a group) take the scalar solver.
+    /// or 2 chains of a joint count after its groups of 16 or 8 (too few for a group) take the scalar solver.
     Lanes = KDW_SOLVER_LANES,
     /// Lanes with the portable kernel copy whatever the CPU has: the same bits, slower (determinism checks).
     LanesPortable = KDW_SOLVER_LANES_PORTABLE,

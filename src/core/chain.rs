@@ -207,7 +207,6 @@ impl Chain {
         self.asleep_world.extend(self.output.iter().map(|local| anchor.mul(local)));
     }
 
-    /// Calls `f` with each joint's world transform (the anchor times the output pose).
     /// [`for_each_world_transform`](Self::for_each_world_transform) into `out` (the chain's joint count): a
     /// copy for a chain asleep under an unmoved anchor.
     pub(crate) fn write_world(&self, out: &mut [Transform]) {
@@ -220,6 +219,7 @@ impl Chain {
         }
     }
 
+    /// Calls `f` with each joint's world transform (the anchor times the output pose).
     pub(crate) fn for_each_world_transform(&self, mut f: impl FnMut(Transform)) {
         if self.asleep && same_bits(&self.anchor, &self.asleep_anchor) {
             self.asleep_world.iter().for_each(|world| f(*world));

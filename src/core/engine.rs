@@ -728,7 +728,7 @@ impl Engine {
             fallbacks += lane_fallbacks;
             contact_pairs += lane_pairs;
             lane_chains = self.lane_jobs.len() as u32;
-            // The last 1 or 2 chains of a joint count after its groups of 8 are faster on the scalar solver.
+            // The last 1 or 2 chains of a joint count after its full lane groups are faster on the scalar solver.
             for job in &self.lane_leftovers {
                 let chain = self.chains.at_mut(job.slot as usize).expect("live");
                 let run = ScalarRun {

@@ -5,7 +5,7 @@
 //! joint count (and limp or not), cuts each run of equal length into groups of 16 (on CPUs with AVX-512:
 //! `has_avx512`), 8 and 4 chains (the last group of a run may repeat one of its chains in its spare lanes),
 //! and advances each group through all of the step's substeps in structure-of-arrays buffers. The last 1 or
-//! 2 chains of a run after its groups of 8, too few for a group to pay, take the scalar solver.
+//! 2 chains of a run after its full groups, too few for a group to pay, take the scalar solver.
 //!
 //! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group, whose phases are compiled one by one;
 //!   [`polar`], [`lengths`] and [`rotations`]: the parts written as loops over lanes, with one lane's
@@ -18,11 +18,12 @@
 //!   x86-64 and aarch64 CPU. It differs from the scalar solver ([`Solver::Scalar`]) by float rounding only
 //!   (the two implement the same operations, grouped differently); `tests/lanes.rs` and the accuracy report
 //!   measure by how much. So whether a chain runs in lanes (every chain of a joint count does but the last 1
-//!   or 2 after its groups of 8) changes its motion by rounding, never more; the same inputs always give the
+//!   or 2 after its full groups) changes its motion by rounding, never more; the same inputs always give the
 //!   same bits.
 //! - Chains that may touch a collider run in lanes too: the contact pass stays scalar, one lane at a time,
-//!   between the vector phases of the substep ([`contacts`]); everything else a chain does (sleeping,
-//!   teleports, momentum suppression, output) is shared with the scalar solver.
+//!   between the vector phases of the substep ([`contacts`]). The render pose is computed in lanes as well
+//!   ([`output`], the scalar code's operations); everything else a chain does (sleeping, teleports, momentum
+//!   suppression) is shared with the scalar solver.
 
 mod contacts;
 mod group;
@@ -56,7 +57,7 @@ pub enum Solver {
     /// same bits, slower. For checking the determinism policy on one machine.
     LanesPortable,
     /// One chain at a time: the reference implementation (and what the last 1 or 2 chains of a joint count
-    /// after its groups of 8 use).
+    /// after its full lane groups use).
     Scalar,
 }
 

@@ -118,7 +118,7 @@ namespace Kodawari
     public enum Solver : uint
     {
         /// <summary>Chains of equal joint count side by side in SIMD lanes (the default; contacts lane by lane). The
-        /// last 1 or 2 chains of a joint count after its groups of 8 (too few for a group) take the scalar solver.</summary>
+        /// last 1 or 2 chains of a joint count after its groups of 16 or 8 (too few for a group) take the scalar solver.</summary>
         Lanes = NativeMethods.KDW_SOLVER_LANES,
         /// <summary><see cref="Lanes"/> with the portable kernel copy whatever the CPU has: the same bits, slower (for
         /// determinism checks).</summary>

@@ -50,7 +50,7 @@ static ALLOCATOR: CountingAllocator = CountingAllocator;
 /// this CPU (contacts scalar, lane by lane), and the scalar solver for the few left over from the lane groups.
 fn solver_path() -> String {
     const NEAR_COLLIDERS: &str = "contacts lane by lane in scalar code; the last 1 or 2 chains of a joint count after \
-                                  its groups of 8 (too few for a group): scalar solver";
+                                  its full groups (too few for a group): scalar solver";
     let lanes = "lane solver (chains of equal joint count in SIMD groups of 16, 8 or 4)";
     match kodawari::simd_path() {
         "avx512" => format!(

@@ -207,10 +207,15 @@ impl Chain {
         self.asleep_world.extend(self.output.iter().map(|local| anchor.mul(local)));
     }
 
+    /// Asleep under the anchor it fell asleep under: its world pose is the stored one.
+    fn shows_stored_pose(&self) -> bool {
+        self.asleep && same_bits(&self.anchor, &self.asleep_anchor)
+    }
+
     /// [`for_each_world_transform`](Self::for_each_world_transform) into `out` (the chain's joint count): a
-    /// copy for a chain asleep under an unmoved anchor.
+    /// copy of the stored pose for a sleeping chain.
     pub(crate) fn write_world(&self, out: &mut [Transform]) {
-        if self.asleep && same_bits(&self.anchor, &self.asleep_anchor) {
+        if self.shows_stored_pose() {
             out.copy_from_slice(&self.asleep_world);
         } else {
             for (world, local) in out.iter_mut().zip(&self.output) {
@@ -221,7 +226,7 @@ impl Chain {
 
     /// Calls `f` with each joint's world transform (the anchor times the output pose).
     pub(crate) fn for_each_world_transform(&self, mut f: impl FnMut(Transform)) {
-        if self.asleep && same_bits(&self.anchor, &self.asleep_anchor) {
+        if self.shows_stored_pose() {
             self.asleep_world.iter().for_each(|world| f(*world));
         } else {
             self.output.iter().for_each(|local| f(self.anchor.mul(local)));

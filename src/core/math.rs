@@ -107,8 +107,8 @@ pub fn swing_to(q: Quat, axis: Vec3, direction: Vec3) -> Quat {
     let current = q * axis;
     let cos = current.dot(direction);
     // Within 90 degrees (every output bone but a folded one) `1 + cos` does not cancel, so float32 gives the
-    // arc to its rounding, without `shortest_arc`'s square roots and divisions in double precision (a tenth of
-    // a frame's time on 1000 x 16 chains). The arc is left unnormalised: the product is normalised anyway.
+    // arc to its rounding, without `shortest_arc`'s square roots and divisions in double precision. The arc is
+    // left unnormalised: the product is normalised anyway.
     let arc = if cos > 0.0 {
         let axis = current.cross(direction);
         Quat::from_xyzw(axis.x, axis.y, axis.z, 1.0 + cos)

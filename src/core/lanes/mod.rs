@@ -162,8 +162,8 @@ pub struct LaneSolver {
 /// holding 2 costs what they cost there). A group of 16 in 512-bit registers runs the same operations on
 /// twice the chains per instruction. The kernel is bound by the latency of its chains of dependent operations
 /// (shape matching goes root to tip), so that shortens its time per chain: 0.76x that of groups of 8 with
-/// AVX2 (median of 16 interleaved runs of `step_cost 1000 16 10 sway`). With AVX2 alone (two 256-bit halves
-/// per operation) groups of 16 were no faster than groups of 8.
+/// AVX2 (`step_cost 1000 16 10 sway` built at 28d84ce and at its parent, run alternately 16 times: median
+/// ratio). With AVX2 alone (two 256-bit halves per operation) groups of 16 were no faster than groups of 8.
 fn group_widths(len: usize, sixteen: bool) -> impl Iterator<Item = (usize, usize)> {
     let sixteens = if sixteen { len / 16 } else { 0 };
     let rest = len - 16 * sixteens;

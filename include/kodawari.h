@@ -505,7 +505,7 @@ kdw_status kdw_engine_get_chain_ids(const struct kdw_engine *engine,
                                     uint32_t *out_written);
 
 // World transforms of every joint of every chain, chains in creation order, joints root to tip, at the
-// render time of the last step (interpolated between internal steps). Rotations are skinning-ready: each
+// time of the last step's call (from the last two internal states; no display latency). Rotations are skinning-ready: each
 // joint's bone axis points at the next joint. `capacity` must be at least the joint count.
 kdw_status kdw_engine_read_world(const struct kdw_engine *engine,
                                  struct kdw_transform *out_transforms,

@@ -4,8 +4,12 @@
 mod common;
 
 use common::*;
+#[path = "../benches/support/pendulum.rs"]
+mod pendulum;
+
 use glam::{Quat, Vec3};
 use kodawari::{ChainParams, EngineSettings, Solver, Transform};
+use pendulum::{Pendulum, Tolerance};
 
 const HEAD: Vec3 = Vec3::new(0.0, 1.6, 0.0);
 
@@ -227,5 +231,47 @@ fn momentum_suppression_tames_orbiting_camera() {
             assert!(peak_on <= 0.01 * peak_off, "stiffness {stiffness}: peak KE ratio {}", peak_on / peak_off);
             assert!(track_on <= 0.02, "stiffness {stiffness}: tracking error {track_on} chain lengths");
         }
+    }
+}
+
+/// The pose a call returns shows the call's own time, not an earlier internal state: a limp double pendulum
+/// (1 m, released straight out) against the exact reference at each call's time `t`, at a frame rate that
+/// divides the substep rate (the pose is the newest internal state) and at one that does not (the last
+/// substep's motion carried on by less than a substep). The same poses against the reference one substep
+/// earlier, `t - h`, are far off: what a one-substep display latency would show.
+#[test]
+fn the_pose_shows_the_call_time() {
+    let links = 2;
+    let reference = Pendulum::uniform(links, 1.0 / links as f64, 1.0, [0.0, -9.81]);
+    let start = reference.state_at_rest(&vec![std::f64::consts::FRAC_PI_2; links]);
+    let exact = |times: &[f64]| -> Vec<Vec<Vec3>> {
+        let (states, _) = reference.solve(0.0, &start, times, Tolerance::REFERENCE);
+        let to_world = |q: &[f64; 2]| HEAD + Vec3::new(q[0] as f32, q[1] as f32, 0.0);
+        times.iter().zip(&states).map(|(t, y)| reference.positions(*t, y).iter().map(to_world).collect()).collect()
+    };
+    let h = 1.0 / EngineSettings::default().substep_rate as f64;
+    for fps in [60u32, 144] {
+        let mut engine = engine_with(EngineSettings::default());
+        let id = engine.create_chain(limp(), &straight_chain(links + 1, Vec3::ZERO, Vec3::X, 0.5)).unwrap();
+        let times: Vec<f64> = (1..=fps / 2).map(|k| k as f64 / fps as f64).collect();
+        let earlier: Vec<f64> = times.iter().map(|t| t - h).collect();
+        let (now, before) = (exact(&times), exact(&earlier));
+        let (mut at_call, mut one_substep_earlier, mut count) = (0.0f64, 0.0f64, 0usize);
+        for k in 0..times.len() {
+            engine.step(1.0 / fps as f32, HEAD + Vec3::new(0.0, 0.0, 3.0), at(HEAD)).unwrap();
+            let pose = chain_world(&engine, id);
+            for j in 1..pose.len() {
+                at_call += (pose[j].position - now[k][j]).length_squared() as f64;
+                one_substep_earlier += (pose[j].position - before[k][j]).length_squared() as f64;
+                count += 1;
+            }
+        }
+        let (at_call, one_substep_earlier) =
+            ((at_call / count as f64).sqrt(), (one_substep_earlier / count as f64).sqrt());
+        println!(
+            "{fps} fps: RMS joint error against the reference at the call time {at_call:.2e} m, one substep earlier {one_substep_earlier:.2e} m"
+        );
+        assert!(at_call <= 1e-3, "{fps} fps: {at_call}");
+        assert!(one_substep_earlier >= 10.0 * at_call, "{fps} fps: {one_substep_earlier} vs {at_call}");
     }
 }

@@ -15,8 +15,7 @@ pub const ROOT: Vec3 = Vec3::new(0.0, 1.6, 0.0);
 const CAMERA: Vec3 = Vec3::new(0.0, 1.6, 3.0);
 const GRAVITY: f64 = 9.81;
 pub const SECONDS: f64 = 0.5;
-/// The reference is sampled at this rate (Hz): every frame time t and kodawari's represented time
-/// t - 1/240 s lie on it.
+/// The reference is sampled at this rate (Hz): every frame time lies on it.
 const GRID: f64 = 240.0;
 
 /// Frames per second, exactly (`FRAME_DT` is an f32 and its reciprocal is not exactly 60).
@@ -66,10 +65,10 @@ impl Reference {
 
 /// RMS over the dynamic joints of `frames` (one list of joint positions per frame, frame k at time
 /// `(k + 1) / 60 - delay`) against the reference.
-pub fn rms_error(reference: &Reference, frames: &[Vec<DVec3>], delay: f64) -> f64 {
+pub fn rms_error(reference: &Reference, frames: &[Vec<DVec3>]) -> f64 {
     let (mut sum, mut count) = (0.0, 0usize);
     for (k, positions) in frames.iter().enumerate() {
-        let t = (k + 1) as f64 / frame_rate() - delay;
+        let t = (k + 1) as f64 / frame_rate();
         let exact = reference.at(t);
         for j in 1..positions.len() {
             sum += (positions[j] - exact[j]).length_squared();
@@ -107,15 +106,10 @@ impl KodawariPendulum {
     pub fn positions(&self) -> Vec<DVec3> {
         self.out.iter().map(|t| t.position.as_dvec3()).collect()
     }
-
-    /// Seconds between the call time and the state the output represents (one internal step).
-    pub fn display_delay(&self) -> f64 {
-        1.0 / self.engine.settings().substep_rate as f64
-    }
 }
 
-/// (physics error, as-seen error) of kodawari over the scenario.
-pub fn kodawari_errors(reference: &Reference) -> (f64, f64) {
+/// kodawari's error over the scenario, its pose after each call against the reference at the call's time.
+pub fn kodawari_error(reference: &Reference) -> f64 {
     let mut run = KodawariPendulum::new(reference.joints);
     let frames: Vec<Vec<DVec3>> = (0..Reference::frames())
         .map(|_| {
@@ -123,5 +117,5 @@ pub fn kodawari_errors(reference: &Reference) -> (f64, f64) {
             run.positions()
         })
         .collect();
-    (rms_error(reference, &frames, run.display_delay()), rms_error(reference, &frames, 0.0))
+    rms_error(reference, &frames)
 }

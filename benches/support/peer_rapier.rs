@@ -262,5 +262,5 @@ pub fn rapier_error(reference: &Reference, solver: JointSolver) -> f64 {
             run.positions.clone()
         })
         .collect();
-    rms_error(reference, &frames, 0.0)
+    rms_error(reference, &frames)
 }

@@ -307,7 +307,7 @@ namespace Kodawari.Native
 
         /// <summary>
         ///  World transforms of every joint of every chain, chains in creation order, joints root to tip, at the
-        ///  render time of the last step (interpolated between internal steps). Rotations are skinning-ready: each
+        ///  time of the last step's call (from the last two internal states; no display latency). Rotations are skinning-ready: each
         ///  joint's bone axis points at the next joint. `capacity` must be at least the joint count.
         /// </summary>
         [DllImport(__DllName, EntryPoint = "kdw_engine_read_world", CallingConvention = CallingConvention.Cdecl, ExactSpelling = true)]

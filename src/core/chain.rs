@@ -332,9 +332,9 @@ impl Chain {
         }
     }
 
-    /// Output pose at fraction `t` between the last two internal states, with every joint's bone axis
-    /// swung onto the next joint (skinning-ready) and its twist kept. The pose is rebuilt from the root along
-    /// the interpolated segment directions with the exact segment lengths: interpolating positions directly
+    /// Output pose at fraction `t` along the last two internal states (see [`output_fraction`]), with every
+    /// joint's bone axis swung onto the next joint (skinning-ready) and its twist kept. The pose is rebuilt
+    /// from the root along the blended segment directions with the exact segment lengths: interpolating positions directly
     /// would shorten a fast-turning bone (by up to 2% at render rates that do not divide the substep rate).
     pub(crate) fn write_output(&mut self, t: f32) {
         let render = RenderInput {
@@ -379,7 +379,7 @@ impl Chain {
     }
 }
 
-/// What [`Chain::write_output`] interpolates: the last two captured poses (relative to the anchor), the bone
+/// What [`Chain::write_output`] blends: the last two captured poses (relative to the anchor), the bone
 /// axes and the segment lengths.
 pub(crate) struct RenderInput<'a> {
     pub previous: &'a [Transform],
@@ -389,7 +389,7 @@ pub(crate) struct RenderInput<'a> {
 }
 
 impl RenderInput<'_> {
-    /// The pose at fraction `t` between the two, into `output` (see [`Chain::write_output`]).
+    /// The pose at fraction `t` along the two (beyond 1: extrapolated), into `output` (see [`Chain::write_output`]).
     pub(crate) fn pose(&self, t: f32, output: &mut [Transform]) {
         let (previous, current) = (self.previous, self.current);
         let n = output.len();
@@ -412,10 +412,14 @@ impl RenderInput<'_> {
     }
 }
 
-/// Where the render pose lies between the last two internal states, for render time `after` seconds past the
-/// newest (`h` the substep).
+/// Where the render pose lies on the line through the last two internal states (0 the older, 1 the newest),
+/// for render time `after` seconds past the newest (`h` the substep, `0 <= after < h`): the pose shows the
+/// call's own time, so it has no latency. Between 1 and 2 it extrapolates the last substep's motion, by less
+/// than one substep; at render rates that divide the substep rate (30, 60, 120, 240 Hz at 240 Hz) `after` is
+/// zero and the pose is the newest state. Interpolating between the two states instead (`after / h`) would
+/// show the state of one substep earlier: the same smoothness, a constant lag of `h`.
 pub(crate) fn output_fraction(h: f64, after: f64) -> f32 {
-    (after / h) as f32
+    (1.0 + after / h) as f32
 }
 
 /// The two transforms are the same to the bit (unlike `==`, which takes `-0.0` for `0.0`): a pose stored under

@@ -140,7 +140,7 @@ pub(crate) struct Clock<'a> {
     pub iterations: u32,
     /// Fraction of the step's anchor motion reached at the end of each substep.
     pub progress: &'a [f32],
-    /// Where the render pose lies between the last two internal states (`Chain::write_output`'s `t`).
+    /// Where the render pose lies along the last two internal states (`Chain::write_output`'s `t`).
     pub output_fraction: f32,
 }
 

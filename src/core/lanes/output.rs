@@ -28,7 +28,7 @@ pub fn capture<const L: usize>(g: &mut LaneGroup<L>, s: usize) {
     }
 }
 
-/// `Chain::write_output` on every lane, at fraction `t` between the last two captured poses.
+/// `Chain::write_output` on every lane, at fraction `t` along the last two captured poses.
 #[inline(always)]
 pub fn write<const L: usize>(g: &mut LaneGroup<L>, t: f32) {
     let n = g.n;

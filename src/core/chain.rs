@@ -58,6 +58,9 @@ pub struct Chain {
     /// The anchor of the last step (world) and the one supplied for the next (own anchors only).
     pub(crate) anchor: Transform,
     pub(crate) anchor_pending: Transform,
+    /// The anchor exactly as the host last gave it (`anchor_pending` is it normalised): the same bits again
+    /// need neither the check nor the normalisation, which were most of a sleeping chain's cost.
+    pub(crate) anchor_given: Option<Transform>,
     /// The last two internal states in the anchor frame, for render interpolation.
     pub(crate) local_previous: Vec<Transform>,
     pub(crate) local_current: Vec<Transform>,
@@ -115,6 +118,7 @@ impl Chain {
             half_kick: true,
             anchor: Transform::IDENTITY,
             anchor_pending: Transform::IDENTITY,
+            anchor_given: None,
             local_previous: local.clone(),
             local_current: local.clone(),
             output: local,
@@ -258,11 +262,11 @@ impl Chain {
     /// Re-blends the rest shape for view direction `view` when it or the shapes changed. A changed rest
     /// shape is flagged so the next substep can suppress the momentum it would inject.
     pub(crate) fn update_rest(&mut self, view: Option<Vec3>) {
-        let view_moved = match (view, self.blended_for) {
+        let view_moved = || match (view, self.blended_for) {
             (Some(v), Some(b)) => (v - b).length() > VIEW_EPSILON,
             (a, b) => a.is_some() != b.is_some(),
         };
-        if !self.shapes_dirty && (self.views.is_empty() || !view_moved) {
+        if !self.shapes_dirty && (self.views.is_empty() || !view_moved()) {
             return;
         }
         self.shapes_dirty = false;
@@ -424,9 +428,12 @@ pub(crate) fn output_fraction(h: f64, after: f64) -> f32 {
 
 /// The two transforms are the same to the bit (unlike `==`, which takes `-0.0` for `0.0`): a pose stored under
 /// one is the pose computed under the other.
-fn same_bits(a: &Transform, b: &Transform) -> bool {
-    let bits = |t: &Transform| (t.position.to_array().map(f32::to_bits), t.rotation.to_array().map(f32::to_bits));
-    bits(a) == bits(b)
+#[inline]
+pub(crate) fn same_bits(a: &Transform, b: &Transform) -> bool {
+    let (p, q) = (a.position.to_array(), a.rotation.to_array());
+    let (r, s) = (b.position.to_array(), b.rotation.to_array());
+    // Folded with `&`, not `&&`: seven compares without a branch each.
+    p.iter().zip(&r).chain(q.iter().zip(&s)).fold(true, |same, (x, y)| same & (x.to_bits() == y.to_bits()))
 }
 
 /// Share of a chain's shortest segment a joint must have been inside a collider at the start of a substep to

@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicU16, Ordering};
 use glam::{Quat, Vec3};
 
 use super::arena::{Arena, Id, Kind};
-use super::chain::{Chain, ViewShape, ViewShapeId, output_fraction, relative_rotation};
+use super::chain::{Chain, ViewShape, ViewShapeId, output_fraction, relative_rotation, same_bits};
 use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderSweep};
 use super::collision::ContactInput;
 use super::error::{Error, Result};
@@ -322,16 +322,22 @@ impl Engine {
                 anchors.len()
             )));
         }
-        for (i, anchor) in anchors.clone().enumerate() {
-            check_transform(&anchor).map_err(|e| Error::invalid_argument(format!("anchor {i}: {e}")))?;
+        let unchanged = |chain: &Chain, anchor: &Transform| chain.anchor_given.is_some_and(|g| same_bits(&g, anchor));
+        for (i, (&slot, anchor)) in self.order.iter().zip(anchors.clone()).enumerate() {
+            let chain = self.chains.at(slot as usize).expect("order holds live chains");
+            if !unchanged(chain, &anchor) {
+                check_transform(&anchor).map_err(|e| Error::invalid_argument(format!("anchor {i}: {e}")))?;
+            }
         }
         for (&slot, anchor) in self.order.iter().zip(anchors) {
             let chain = self.chains.at_mut(slot as usize).expect("order holds live chains");
-            let anchor = normalized_transform(&anchor);
-            chain.anchor_pending = anchor;
+            if !unchanged(chain, &anchor) {
+                chain.anchor_pending = normalized_transform(&anchor);
+                chain.anchor_given = Some(anchor);
+            }
             if !chain.placed && chain.params.anchor == AnchorSource::Own {
                 // Until its first step a new chain reads back in its rest shape under this anchor.
-                chain.anchor = anchor;
+                chain.anchor = chain.anchor_pending;
             }
         }
         Ok(())

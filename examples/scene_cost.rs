@@ -5,18 +5,20 @@
 //! by the dynamic joints and substeps printed. Scenes: `100x16`, `1000x16`, `1x1000` (0.8 m rope), `1x1000_hair`
 //! (2.5 cm segments); variants: `lanes` (default), `scalar`, `colliders`
 //! (the head sphere, shoulders and ground of the report's colliders variant, on the lane solver) and
-//! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair). It also prints the
+//! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair), `lod1` and `lod2`. It also prints the
 //! engine's state hash and the contact pairs tested, so that two builds can be checked to compute the same
 //! bits on a scene.
 
 #[path = "../benches/support/scenes.rs"]
 mod scenes;
 
-use scenes::{ASLEEP, AWAKE_AT_REST, COLLIDERS, COLLIDERS_SCALAR, PLAIN, PLAIN_SCALAR, ReadBack, Scene, SceneRun};
+use scenes::{
+    ASLEEP, AWAKE_AT_REST, COLLIDERS, COLLIDERS_SCALAR, LOD1, LOD2, PLAIN, PLAIN_SCALAR, ReadBack, Scene, SceneRun,
+};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest]";
+    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest|lod1|lod2]";
     let frames: u64 = args.first().and_then(|f| f.parse().ok()).expect(usage);
     let scene = match args.get(1).map(String::as_str) {
         Some("100x16") => Scene::uniform("100x16", 100, 16),
@@ -31,6 +33,8 @@ fn main() {
         Some("colliders_scalar") => COLLIDERS_SCALAR,
         Some("asleep") => ASLEEP,
         Some("awake_at_rest") => AWAKE_AT_REST,
+        Some("lod1") => LOD1,
+        Some("lod2") => LOD2,
         _ => PLAIN,
     };
     let mut run = SceneRun::new(&scene, variant, ReadBack::World).expect("the scene builds");

@@ -45,6 +45,12 @@ pub struct ImplicitScratch {
     pivots: Vec<DMat4>,
     /// Per block: the elimination's modified right-hand side, which the pass back reads.
     rhs: Vec<DVec4>,
+    /// Per particle: the start's offset from the positions being projected (with `shifted`), and after a
+    /// projection that converged, its answer's.
+    correction: Vec<DVec3>,
+    shifted: bool,
+    /// Newton steps the last projection took.
+    steps: u32,
 }
 
 impl ImplicitScratch {
@@ -54,6 +60,7 @@ impl ImplicitScratch {
             self.target.resize(bonds + 1, DVec3::ZERO);
             self.pivots.resize(bonds, DMat4::ZERO);
             self.rhs.resize(bonds, DVec4::ZERO);
+            self.correction.resize(bonds + 1, DVec3::ZERO);
         }
     }
 }
@@ -95,6 +102,18 @@ impl ImplicitScratch {
         for (mu, &g) in self.mu.iter_mut().zip(guess) {
             *mu = if g.is_finite() { pulling(g) } else { 0.0 };
         }
+        self.shifted = false;
+    }
+
+    /// [`begin`](Self::begin), with Newton started from `p + shift` instead of `p` (one offset per particle;
+    /// the first is ignored). The same chain's last correction is a good shift: within a substep a rope's
+    /// correction hardly changes, and from `p` alone its first bond errors are tens of percent (bug 1's fine
+    /// rope: a step less in two thirds of its projections, docs/robustness.md).
+    pub fn begin_shifted(&mut self, p: &[DVec3], guess: &[f64], shift: &[DVec3]) {
+        self.begin(p, guess);
+        let m = guess.len();
+        self.correction[..m + 1].copy_from_slice(&shift[..m + 1]);
+        self.shifted = true;
     }
 }
 
@@ -102,6 +121,17 @@ impl ImplicitScratch {
     /// The multipliers of the last projection, for a chain of `bonds` bonds.
     pub fn multipliers(&self, bonds: usize) -> &[f64] {
         &self.mu[..bonds]
+    }
+
+    /// Newton steps the last projection took.
+    #[cfg(test)]
+    pub fn steps(&self) -> u32 {
+        self.steps
+    }
+
+    /// The last converged projection's answer minus the positions it projected, per particle (the root's 0).
+    pub fn correction(&self, bonds: usize) -> &[DVec3] {
+        &self.correction[..bonds + 1]
     }
 }
 
@@ -123,14 +153,23 @@ pub fn project_portable(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: 
 #[inline(always)]
 fn project_in(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &mut ImplicitScratch) -> bool {
     let m = l2.len();
-    let ImplicitScratch { mu, target, pivots, rhs } = s;
+    let ImplicitScratch { mu, target, pivots, rhs, correction, shifted, steps } = s;
+    *steps = 0;
     let (mu, target, pivots, rhs) = (&mut mu[..m], &target[..m + 1], &mut pivots[..m], &mut rhs[..m]);
-    let p = &mut p[..m + 1];
+    let (p, correction) = (&mut p[..m + 1], &mut correction[..m + 1]);
     p.copy_from_slice(target);
+    if *shifted {
+        for j in 1..=m {
+            p[j] += correction[j];
+        }
+    }
     let mut limit = f64::NAN;
     for iteration in 0..MAX_ITERATIONS {
         let worst = worst_error(p, inv_l2);
         if worst <= tolerance {
+            for j in 0..=m {
+                correction[j] = p[j] - target[j];
+            }
             return true;
         }
         if iteration == 0 {
@@ -142,6 +181,7 @@ fn project_in(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &m
         if !newton_step(p, target, mu, l2, pivots, rhs) {
             break;
         }
+        *steps += 1;
     }
     p.copy_from_slice(target);
     false

@@ -72,6 +72,7 @@ impl ScalarRun<'_> {
         let slop = chain.contact_slop();
         let substeps = self.progress.len();
         let (mut fallbacks, mut contact_pairs) = (0, 0);
+        let mut ended_clear = false;
         for (s, &progress) in self.progress.iter().enumerate() {
             let anchor = self.start.interpolate(&self.target, progress);
             let touching = contacts.as_ref().is_some_and(|c| !c.candidates.is_empty());
@@ -96,8 +97,10 @@ impl ScalarRun<'_> {
                     friction: chain.params.friction,
                     slop,
                 }),
+                starts_clear: s > 0 && ended_clear,
             };
             let report = substep(&mut chain.state, &chain.frame.lengths, &input, scratch);
+            ended_clear = report.ended_clear;
             fallbacks += report.fallback as u64;
             contact_pairs += report.contact_pairs;
             chain.half_kick = false;

@@ -130,6 +130,10 @@ pub struct SubstepInput<'a> {
     pub half_kick: bool,
     /// The colliders this chain can touch during this substep; `None` runs no collision code.
     pub contacts: Option<ContactInput<'a>>,
+    /// The substep before, in the same step, ended on a contact pass that touched nothing
+    /// ([`SubstepReport::ended_clear`]): the positions start outside every collider at this substep's start
+    /// pose (that substep's end pose), so pre-stabilisation would find nothing and is skipped.
+    pub starts_clear: bool,
 }
 
 /// What a substep reports back for the engine's counters.
@@ -139,6 +143,8 @@ pub struct SubstepReport {
     pub fallback: bool,
     /// (segment or particle, collider) pairs tested.
     pub contact_pairs: u64,
+    /// The substep's last contact pass touched nothing.
+    pub ended_clear: bool,
 }
 
 /// Per-particle buffers reused across chains and substeps.
@@ -176,7 +182,7 @@ pub fn substep(
     let h = input.h;
     let RodScratch { p, qp, p_old, constraints, bounds } = scratch;
     let settled = input.contact_settled;
-    if let Some(contacts) = &input.contacts {
+    if let Some(contacts) = input.contacts.as_ref().filter(|_| !input.starts_clear) {
         let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
             inextensible::solve(previous, x, lengths, constraints);
         };
@@ -241,6 +247,7 @@ pub fn substep(
                     report.contact_pairs += pass.tested;
                 }
             }
+            report.ended_clear = !pass.touching;
         }
     }
 

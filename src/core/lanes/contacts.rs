@@ -30,6 +30,8 @@ pub(crate) struct LaneContacts {
     pub settled: f32,
     /// The last contact pass of the current substep.
     pub pass: Option<ContactPass>,
+    /// `SubstepInput::starts_clear`: the substep before, in the same step, ended on a pass that touched nothing.
+    pub starts_clear: bool,
 }
 
 impl LaneContacts {
@@ -48,14 +50,19 @@ impl LaneContacts {
         let row = &all[s * colliders..][..colliders];
         self.sweeps.clear();
         self.sweeps.extend(self.candidates.iter().map(|&c| row[c]));
+        self.starts_clear = s > 0 && self.pass.is_some_and(|pass| !pass.touching);
         self.pass = None;
     }
 }
 
-/// Pre-stabilisation (`collision::pre_stabilise`) of the start positions of the lanes in `lanes`.
+/// Pre-stabilisation (`collision::pre_stabilise`) of the start positions of the lanes in `lanes` (not those
+/// that start clear: see `LaneContacts::starts_clear`).
 pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) {
     let n = g.n;
     for lane in (0..L).filter(|&lane| lanes.0[lane]) {
+        if g.contacts[lane].starts_clear {
+            continue;
+        }
         let LaneGroup { x, lengths, lane_x, lane_scratch, lane_lengths, contacts, constraints, segment_bounds, .. } = g;
         extract(&x[..n], lane, lane_x);
         lane_lengths.clear();

@@ -64,7 +64,7 @@ impl Reference {
 }
 
 /// RMS over the dynamic joints of `frames` (one list of joint positions per frame, frame k at time
-/// `(k + 1) / 60 - delay`) against the reference.
+/// `(k + 1) / 60`) against the reference.
 pub fn rms_error(reference: &Reference, frames: &[Vec<DVec3>]) -> f64 {
     let (mut sum, mut count) = (0.0, 0usize);
     for (k, positions) in frames.iter().enumerate() {

@@ -106,9 +106,9 @@ impl ImplicitScratch {
     }
 
     /// [`begin`](Self::begin), with Newton started from `p + shift` instead of `p` (one offset per particle;
-    /// the first is ignored). The same chain's last correction is a good shift: within a substep a rope's
-    /// correction hardly changes, and from `p` alone its first bond errors are tens of percent (bug 1's fine
-    /// rope: a step less in two thirds of its projections, docs/robustness.md).
+    /// the first is ignored). The same chain's last correction is a good shift: from one substep to the next a
+    /// rope's correction hardly changes, and from `p` alone its first bond errors are tens of percent (bug 1's
+    /// fine rope, docs/robustness.md).
     pub fn begin_shifted(&mut self, p: &[DVec3], guess: &[f64], shift: &[DVec3]) {
         self.begin(p, guess);
         let m = guess.len();

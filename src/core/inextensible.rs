@@ -148,6 +148,15 @@ impl SolveMemory {
         self.exact_streak = 0;
     }
 
+    /// The chain was carried rigidly by `rotation` (a teleport): the remembered corrections, world vectors,
+    /// turn with it (the tensions do not depend on the orientation).
+    pub fn turn(&mut self, rotation: glam::Quat) {
+        let rotation = rotation.as_dquat();
+        for c in &mut self.correction {
+            *c = rotation * *c;
+        }
+    }
+
     /// Words for the engine's state hash (the tensions only while they are used).
     pub fn words(&self) -> impl Iterator<Item = u64> + '_ {
         let (tension, correction) =
@@ -697,6 +706,28 @@ mod tests {
         assert!(apart < 1e-12, "{apart}");
         assert!(shifted_steps < plain_steps, "{shifted_steps} vs {plain_steps}");
         assert!(max_stretch(&shifted, &lengths) < 1e-6);
+
+        // The rope carried rigidly by a half turn about its root (a teleport, `RodState::carry`; exact in
+        // floating point, so the turned answer is the answer turned): its memory turns with it and gives the
+        // turned start the same head start.
+        let turn = glam::Quat::from_xyzw(0.0, 0.0, 1.0, 0.0);
+        let mut memory = SolveMemory::new(m);
+        memory.correction.copy_from_slice(&correction);
+        memory.turn(turn);
+        let rotate = |v: &DVec3| turn.as_dquat() * *v;
+        let mut turned: Vec<DVec3> = predict(2e-5).iter().map(rotate).collect();
+        let (_, _, turned_steps) = project(&mut turned, &tension, Some(&memory.correction));
+        let apart = turned.iter().zip(&shifted).map(|(a, b)| (*a - rotate(b)).length()).fold(0.0, f64::max);
+        assert!(apart < 1e-12, "{apart}");
+        assert_eq!(turned_steps, shifted_steps);
+        let mut unturned: Vec<DVec3> = predict(2e-5).iter().map(rotate).collect();
+        s.implicit.begin_shifted(&unturned, &tension, &correction);
+        let converged = implicit::project(&mut unturned, &l2, &inv_l2, TOLERANCE, &mut s.implicit);
+        println!("unturned memory: converged {converged} after {} steps", s.implicit.steps());
+        assert!(
+            !converged || s.implicit.steps() > shifted_steps,
+            "the turn must matter for this test to mean anything"
+        );
     }
 
     #[test]

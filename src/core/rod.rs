@@ -76,6 +76,7 @@ impl RodState {
         for q in self.q.iter_mut().chain(self.group_rotation.iter_mut()) {
             *q = (delta.rotation * *q).normalize();
         }
+        self.solve_memory.turn(delta.rotation);
     }
 
     pub fn translate(&mut self, offset: DVec3) {

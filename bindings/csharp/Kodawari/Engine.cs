@@ -264,7 +264,7 @@ namespace Kodawari
         }
 
         /// <summary>World transforms of every joint of every chain (chains in creation order, root to tip), at the
-        /// render time of the last step. <paramref name="output"/> needs at least <see cref="JointCount"/> entries.
+        /// time of the last step's call. <paramref name="output"/> needs at least <see cref="JointCount"/> entries.
         /// Returns how many were written.</summary>
         public int ReadWorld(Span<JointTransform> output)
         {

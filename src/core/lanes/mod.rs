@@ -445,7 +445,7 @@ fn run_group<const L: usize>(
             kernel::substep(g, s, phases)
         };
         fallbacks += fell_back.0[..jobs.len()].iter().filter(|&&f| f).count() as u64;
-        // The render interpolation keeps the last two internal poses.
+        // The output pose uses the last two internal poses.
         if s + 2 >= substeps {
             (phases.capture)(g, s);
         }

@@ -141,7 +141,8 @@ mod tests {
                 g.lengths[k].0[lane] = l;
             }
         }
-        for t in [0.0, 0.4, 1.0] {
+        // 1 to 2: the pose carried on past the newest state (`chain::output_fraction`).
+        for t in [0.0, 0.4, 1.0, 1.5, 1.99] {
             super::write(&mut g, t);
             for lane in 0..L {
                 let (previous, current, axes) = poses(lane, n);

@@ -183,11 +183,18 @@ pub fn substep(
     let h = input.h;
     let RodScratch { p, qp, p_old, constraints, bounds } = scratch;
     let settled = input.contact_settled;
-    if let Some(contacts) = input.contacts.as_ref().filter(|_| !input.starts_clear) {
+    if let Some(contacts) = &input.contacts {
         let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
             inextensible::solve(previous, x, lengths, constraints);
         };
-        pre_stabilise(&mut state.x, &mut p_old[..n], contacts, FINAL_CONTACT_ROUNDS, keep_lengths, settled, bounds);
+        if !input.starts_clear {
+            pre_stabilise(&mut state.x, &mut p_old[..n], contacts, FINAL_CONTACT_ROUNDS, keep_lengths, settled, bounds);
+        } else if cfg!(debug_assertions) {
+            // The skip must change nothing: pre-stabilise a copy (in `p`, not yet written) and compare.
+            p[..n].copy_from_slice(&state.x);
+            pre_stabilise(&mut p[..n], &mut p_old[..n], contacts, FINAL_CONTACT_ROUNDS, keep_lengths, settled, bounds);
+            debug_assert!(same_bits(&p[..n], &state.x), "a substep that starts clear had something to pre-stabilise");
+        }
     }
     // The start positions give the inextensibility solve its correction directions; only the contact pass
     // moves them (joints already inside a collider), and every solve after it is prepared again.
@@ -425,4 +432,9 @@ fn pull_to_goal(p: &mut DVec3, centre: DVec3, offset: Vec3A, alpha: f64) {
 #[inline(always)]
 fn outer(u: Vec3A, v: Vec3A) -> Mat3A {
     Mat3A::from_cols(u * v.x, u * v.y, u * v.z)
+}
+
+/// The positions are equal to the bit (debug checks).
+pub(crate) fn same_bits(a: &[DVec3], b: &[DVec3]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits))
 }

@@ -61,6 +61,33 @@ fn a_settled_chain_sleeps_where_it_would_rest() {
     }
 }
 
+/// The slice read-backs (`read_world`, `read_chain_world`) agree with the visitor on an engine whose chains
+/// have different lengths, one asleep and one awake, so every chain's offset in the shared buffer counts.
+#[test]
+fn read_backs_agree_with_the_visitor_chain_by_chain() {
+    let mut engine = engine_with(EngineSettings::default());
+    let still = engine
+        .create_chain(ChainParams { damping: 3.0, ..Default::default() }, &straight_chain(5, Vec3::ZERO, Vec3::X, 0.05))
+        .unwrap();
+    let swinging = engine.create_chain(limp(), &straight_chain(9, Vec3::ZERO, Vec3::Z, 0.05)).unwrap();
+    let third = engine.create_chain(ChainParams::default(), &straight_chain(3, Vec3::ZERO, Vec3::Y, 0.1)).unwrap();
+    settle(&mut engine, 12.0);
+    assert!(engine.is_chain_asleep(still).unwrap() && !engine.is_chain_asleep(swinging).unwrap());
+    let mut visited = Vec::new();
+    engine.for_each_world_transform(engine.joint_count(), |t| visited.push(t)).unwrap();
+    let mut read = vec![Transform::IDENTITY; engine.joint_count()];
+    assert_eq!(engine.read_world(&mut read).unwrap(), 17);
+    assert_eq!(read, visited);
+    let mut offset = 0;
+    for id in [still, swinging, third] {
+        let n = engine.chain_joint_count(id).unwrap();
+        let mut one = vec![Transform::IDENTITY; n + 1];
+        assert_eq!(engine.read_chain_world(id, &mut one).unwrap(), n);
+        assert_eq!(one[..n], visited[offset..offset + n]);
+        offset += n;
+    }
+}
+
 /// Anything that changes a chain's situation wakes it: its anchor, its parameters, the view when it has view
 /// shapes, a collider moving near it, gravity.
 #[test]

@@ -691,7 +691,7 @@ mod tests {
             let moved =
                 pre_stabilise(&mut x, &mut scratch, &input(&next), 4, keep_lengths, 0.0, &mut SegmentBounds::default());
             assert!(!moved);
-            assert!(x.iter().zip(&p).all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits)));
+            assert!(crate::core::rod::same_bits(&x, &p));
         }
         assert!(clear > 100 && touched > 100, "clear {clear}, touched {touched}: the test needs both");
     }

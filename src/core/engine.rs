@@ -902,7 +902,11 @@ impl Engine {
 
     /// World transforms of one chain's joints into `out`; returns how many were written.
     pub fn read_chain_world(&self, id: ChainId, out: &mut [Transform]) -> Result<usize> {
-        fill_slice(out, |capacity, f| self.for_each_chain_world_transform(id, capacity, f))
+        let chain = self.chain(id)?;
+        check_chain_capacity(chain, out.len())?;
+        let n = chain.joint_count();
+        chain.write_world(&mut out[..n]);
+        Ok(n)
     }
 
     /// The rest shape a chain is currently pulled towards (anchor frame) into `out`.

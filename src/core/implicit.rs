@@ -49,8 +49,6 @@ pub struct ImplicitScratch {
     /// projection that converged, its answer's.
     correction: Vec<DVec3>,
     shifted: bool,
-    /// Newton steps the last projection took.
-    steps: u32,
 }
 
 impl ImplicitScratch {
@@ -123,12 +121,6 @@ impl ImplicitScratch {
         &self.mu[..bonds]
     }
 
-    /// Newton steps the last projection took.
-    #[cfg(test)]
-    pub fn steps(&self) -> u32 {
-        self.steps
-    }
-
     /// The last converged projection's answer minus the positions it projected, per particle (the root's 0).
     pub fn correction(&self, bonds: usize) -> &[DVec3] {
         &self.correction[..bonds + 1]
@@ -140,21 +132,28 @@ impl ImplicitScratch {
 /// `|b|^2 / l^2 - 1`. Returns `false` when Newton fails; `p` then holds the positions given to `begin`.
 #[multiversion(targets("x86_64+avx2"))]
 pub fn project(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &mut ImplicitScratch) -> bool {
-    project_in(p, l2, inv_l2, tolerance, s)
+    project_in(p, l2, inv_l2, tolerance, s).is_some()
 }
 
-/// [`project`] compiled for the baseline instruction set only: the tests check that both copies give the same
-/// bits (no fused or reordered operations), as the lane kernels' copies do.
+/// [`project`] compiled for the baseline instruction set only, returning the Newton steps it took when it
+/// converged: the tests check that both copies give the same bits (no fused or reordered operations), as the
+/// lane kernels' copies do, and count steps.
 #[cfg(test)]
-pub fn project_portable(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &mut ImplicitScratch) -> bool {
+pub fn project_portable(
+    p: &mut [DVec3],
+    l2: &[f64],
+    inv_l2: &[f64],
+    tolerance: f64,
+    s: &mut ImplicitScratch,
+) -> Option<usize> {
     project_in(p, l2, inv_l2, tolerance, s)
 }
 
+/// [`project`], returning the Newton steps taken when it converged.
 #[inline(always)]
-fn project_in(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &mut ImplicitScratch) -> bool {
+fn project_in(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &mut ImplicitScratch) -> Option<usize> {
     let m = l2.len();
-    let ImplicitScratch { mu, target, pivots, rhs, correction, shifted, steps } = s;
-    *steps = 0;
+    let ImplicitScratch { mu, target, pivots, rhs, correction, shifted } = s;
     let (mu, target, pivots, rhs) = (&mut mu[..m], &target[..m + 1], &mut pivots[..m], &mut rhs[..m]);
     let (p, correction) = (&mut p[..m + 1], &mut correction[..m + 1]);
     p.copy_from_slice(target);
@@ -170,7 +169,7 @@ fn project_in(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &m
             for j in 0..=m {
                 correction[j] = p[j] - target[j];
             }
-            return true;
+            return Some(iteration);
         }
         if iteration == 0 {
             limit = DIVERGED * worst.max(1.0);
@@ -181,10 +180,9 @@ fn project_in(p: &mut [DVec3], l2: &[f64], inv_l2: &[f64], tolerance: f64, s: &m
         if !newton_step(p, target, mu, l2, pivots, rhs) {
             break;
         }
-        *steps += 1;
     }
     p.copy_from_slice(target);
-    false
+    None
 }
 
 /// One block's rows of the Newton system before elimination, and the bonds and stiffnesses that couple it to

@@ -409,7 +409,7 @@ fn error_after_step(d: &[DVec3], step: &[f64], inv_l2: &[f64]) -> f64 {
     let mut worst = 0.0f64;
     let mut below = DVec3::ZERO;
     for k in 0..m {
-        let above = if k + 1 < m { d[k] * step[k] - d[k + 1] * step[k + 1] } else { d[k] * step[k] };
+        let above = shift(d, step, k + 1);
         let error = (above - below).length_squared() * inv_l2[k];
         if error > worst {
             worst = error;
@@ -654,13 +654,8 @@ mod tests {
         assert!(implicit::project(&mut projected, l2, inv_l2, TOLERANCE, &mut s.implicit));
         let mut portable = predicted.clone();
         s.implicit.begin(&portable, &multipliers);
-        assert!(implicit::project_portable(&mut portable, l2, inv_l2, TOLERANCE, &mut s.implicit));
-        assert!(
-            projected
-                .iter()
-                .zip(&portable)
-                .all(|(a, b)| a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits))
-        );
+        assert!(implicit::project_portable(&mut portable, l2, inv_l2, TOLERANCE, &mut s.implicit).is_some());
+        assert!(crate::core::rod::same_bits(&projected, &portable));
         assert!(max_stretch(&projected, &lengths) < 1e-6, "{}", max_stretch(&projected, &lengths));
         assert_eq!(projected[0], x[0]);
         let (nearest, other) = (distance(&projected), distance(&direct));
@@ -691,8 +686,8 @@ mod tests {
                 Some(shift) => s.implicit.begin_shifted(p, tension, shift),
                 None => s.implicit.begin(p, tension),
             }
-            assert!(implicit::project(p, &l2, &inv_l2, TOLERANCE, &mut s.implicit));
-            (s.implicit.multipliers(m).to_vec(), s.implicit.correction(m).to_vec(), s.implicit.steps())
+            let steps = implicit::project_portable(p, &l2, &inv_l2, TOLERANCE, &mut s.implicit).expect("converges");
+            (s.implicit.multipliers(m).to_vec(), s.implicit.correction(m).to_vec(), steps)
         };
         let mut before = predict(0.0);
         let (tension, correction, _) = project(&mut before, &vec![0.0; m], None);
@@ -722,10 +717,10 @@ mod tests {
         assert_eq!(turned_steps, shifted_steps);
         let mut unturned: Vec<DVec3> = predict(2e-5).iter().map(rotate).collect();
         s.implicit.begin_shifted(&unturned, &tension, &correction);
-        let converged = implicit::project(&mut unturned, &l2, &inv_l2, TOLERANCE, &mut s.implicit);
-        println!("unturned memory: converged {converged} after {} steps", s.implicit.steps());
+        let unturned_steps = implicit::project_portable(&mut unturned, &l2, &inv_l2, TOLERANCE, &mut s.implicit);
+        println!("unturned memory: {unturned_steps:?} steps");
         assert!(
-            !converged || s.implicit.steps() > shifted_steps,
+            unturned_steps.is_none_or(|steps| steps > shifted_steps),
             "the turn must matter for this test to mean anything"
         );
     }

@@ -84,8 +84,7 @@ pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) {
             segment_bounds,
         );
         if skip {
-            lane_scratch.clear();
-            lane_scratch.extend(x[..n].iter().map(|v| DVec3::from_array(v.get(lane))));
+            extract(&x[..n], lane, lane_scratch);
             debug_assert!(
                 crate::core::rod::same_bits(lane_x, lane_scratch),
                 "lane {lane} had something to pre-stabilise"

@@ -9,7 +9,8 @@
 //!
 //! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group, whose phases are compiled one by one;
 //!   [`polar`], [`lengths`] and [`rotations`]: the parts written as loops over lanes, with one lane's
-//!   arithmetic in [`scalar`]; [`contacts`]: the contact pass, lane by lane; [`group`]: the buffers.
+//!   arithmetic in [`scalar`]; [`contacts`]: the contact pass, lane by lane; [`group`]: the buffers;
+//!   [`prefetch`]: the next group's chain data requested while a group runs.
 //! - The wide copies of the kernel are compiled for AVX2 (groups of 8 and 4) and AVX-512 (groups of 16) next
 //!   to the portable (SSE2) one and chosen at run time by CPU-feature detection ([`multiversion`]); no build
 //!   needs `target-cpu=native`.
@@ -31,6 +32,7 @@ mod kernel;
 mod lengths;
 mod output;
 mod polar;
+mod prefetch;
 mod rotations;
 mod scalar;
 mod simd;
@@ -219,6 +221,9 @@ impl LaneSolver {
             for (count, width) in group_widths(same, sixteen) {
                 let (group, remaining) = run.split_at(count);
                 run = remaining;
+                // The next group's chains arrive while this one runs.
+                let next = if run.is_empty() { rest } else { run };
+                prefetch::chains_of(chains, &next[..next.len().min(width)]);
                 let (group_fallbacks, group_pairs) = match (width, portable) {
                     (16, _) => run_group(&mut self.g16, chains, group, clock, reach, &WIDE16),
                     (8, false) => run_group(&mut self.g8, chains, group, clock, reach, &WIDE8),

@@ -97,7 +97,7 @@ fn joints(n: u32, seed: u64, f: f32) -> Vec<kdw_transform> {
             }
         })
         .collect();
-    if n > 0 && seed % 4 == 0 {
+    if n > 0 && seed.is_multiple_of(4) {
         let k = (seed / 4) as usize % n as usize;
         match (seed / 64) % 4 {
             0 => out[k].position.x = f,
@@ -234,7 +234,7 @@ impl World {
         let status = match c.kind {
             0 => return self.create_engine(c),
             1 => {
-                if c.pick2 % 8 == 0 {
+                if c.pick2.is_multiple_of(8) {
                     // Destroy the engine: every id of it dies with it.
                     prop_assert_eq!(kdw_engine_destroy(engine), KDW_STATUS_OK);
                     self.engines.remove(e);
@@ -309,7 +309,7 @@ impl World {
                 let chain = self.chain_id(e, c.pick2);
                 let mut n = 0;
                 kdw_chain_joint_count(engine, chain, &mut n);
-                let n = if c.pick % 5 == 0 { c.n } else { n };
+                let n = if c.pick.is_multiple_of(5) { c.n } else { n };
                 let j = joints(n, c.pick2 / 11 + 1, c.f[2]);
                 let mut id = 0;
                 let s = kdw_chain_add_view_shape(
@@ -355,8 +355,9 @@ impl World {
                     0 => c.n,
                     _ => chains,
                 };
-                let anchors: Vec<kdw_transform> =
-                    (0..count).map(|i| transform(c.f, c.pick2 % 3 != 0 || i + 1 < count, self.untamed)).collect();
+                let anchors: Vec<kdw_transform> = (0..count)
+                    .map(|i| transform(c.f, !c.pick2.is_multiple_of(3) || i + 1 < count, self.untamed))
+                    .collect();
                 kdw_engine_set_anchors(engine, anchors.as_ptr(), count)
             }
             12..=14 => {
@@ -365,8 +366,9 @@ impl World {
                     1 => c.f[0].abs() * 0.1,
                     _ => 1.0 / 60.0,
                 };
-                let k = transform(c.f, c.pick2 % 5 != 0, self.untamed);
-                let camera = if c.pick2 % 7 == 0 { vec3(tame(c.f[3]), 0.0, c.f[1]) } else { vec3(0.0, 1.7, 3.0) };
+                let k = transform(c.f, !c.pick2.is_multiple_of(5), self.untamed);
+                let camera =
+                    if c.pick2.is_multiple_of(7) { vec3(tame(c.f[3]), 0.0, c.f[1]) } else { vec3(0.0, 1.7, 3.0) };
                 let s = kdw_engine_step(engine, dt, &camera, &k);
                 if s == KDW_STATUS_OK && dt > 0.0 {
                     // This step's counters: chains in lanes are awake, and the scalar solver puts none in lanes.
@@ -409,7 +411,7 @@ impl World {
                 let chain = self.chain_id(e, c.pick2);
                 let mut out = vec![kdw_transform::default(); c.n as usize];
                 let mut written = 0;
-                let s = if c.pick % 2 == 0 {
+                let s = if c.pick.is_multiple_of(2) {
                     kdw_chain_read_world(engine, chain, out.as_mut_ptr(), c.n, &mut written)
                 } else {
                     kdw_chain_read_rest_shape(engine, chain, out.as_mut_ptr(), c.n, &mut written)
@@ -425,7 +427,7 @@ impl World {
                 s
             }
             18 => {
-                if c.pick2 % 2 == 0 {
+                if c.pick2.is_multiple_of(2) {
                     kdw_engine_reset(engine)
                 } else {
                     kdw_chain_reset(engine, self.chain_id(e, c.pick2))
@@ -462,7 +464,7 @@ impl World {
                 kdw_chain_set_def(engine, self.chain_id(e, c.pick2), &def)
             }
             21 => {
-                if c.pick % 8 == 0 {
+                if c.pick.is_multiple_of(8) {
                     // Switch solver between steps: the three KDW_SOLVER_* values and an unknown one.
                     let solver = (c.pick2 % 4) as u32;
                     let s = kdw_engine_set_solver(engine, solver);
@@ -482,7 +484,7 @@ impl World {
                 let chain = self.chain_id(e, c.pick2);
                 let mut n = 0;
                 kdw_chain_joint_count(engine, chain, &mut n);
-                let n = if c.pick % 4 == 0 { c.n } else { n };
+                let n = if c.pick.is_multiple_of(4) { c.n } else { n };
                 let j = joints(n, c.pick2 / 13 + 2, c.f[0]);
                 kdw_chain_set_base_shape(engine, chain, j.as_ptr(), n)
             }
@@ -496,11 +498,11 @@ impl World {
                 // Create a collider: any shape (also unknown ones), random sizes, a valid or broken pose.
                 let mut def = kdw_collider_def_default();
                 def.shape = (c.pick2 % 6) as u32;
-                def.radius = if c.pick2 % 3 == 0 { c.f[0] } else { c.f[0].abs() % 0.5 };
-                def.half_height = if c.pick2 % 5 == 0 { c.f[1] } else { c.f[1].abs() % 0.5 };
-                def.transform = transform(c.f, c.pick2 % 4 != 0, self.untamed);
+                def.radius = if c.pick2.is_multiple_of(3) { c.f[0] } else { c.f[0].abs() % 0.5 };
+                def.half_height = if c.pick2.is_multiple_of(5) { c.f[1] } else { c.f[1].abs() % 0.5 };
+                def.transform = transform(c.f, !c.pick2.is_multiple_of(4), self.untamed);
                 def.layers = (c.pick2 >> 16) as u32;
-                if c.pick2 % 11 == 0 {
+                if c.pick2.is_multiple_of(11) {
                     def.struct_size = c.n;
                 }
                 const UNWRITTEN: u64 = 0xDEAD_BEEF_CAFE_F00D;
@@ -535,9 +537,10 @@ impl World {
             27 => {
                 // Batched collider poses: the right count most of the time, one broken pose now and then.
                 let colliders = Self::collider_count(engine);
-                let count = if c.pick2 % 4 == 0 { c.n } else { colliders };
-                let poses: Vec<kdw_transform> =
-                    (0..count).map(|i| transform(c.f, c.pick2 % 3 != 0 || i + 1 < count, self.untamed)).collect();
+                let count = if c.pick2.is_multiple_of(4) { c.n } else { colliders };
+                let poses: Vec<kdw_transform> = (0..count)
+                    .map(|i| transform(c.f, !c.pick2.is_multiple_of(3) || i + 1 < count, self.untamed))
+                    .collect();
                 let s = kdw_engine_set_collider_transforms(engine, poses.as_ptr(), count);
                 if count != colliders {
                     prop_assert_eq!(s, KDW_STATUS_INVALID_ARGUMENT, "collider pose count {} of {}", count, colliders);
@@ -569,7 +572,7 @@ impl World {
             _ => {
                 // Collider ids read back: creation order, exactly the live ones the fuzzer knows.
                 let colliders = Self::collider_count(engine);
-                let capacity = if c.pick2 % 3 == 0 { c.n } else { colliders };
+                let capacity = if c.pick2.is_multiple_of(3) { c.n } else { colliders };
                 let mut ids = vec![0u64; capacity as usize];
                 let mut written = 0;
                 let s = kdw_engine_get_collider_ids(engine, ids.as_mut_ptr(), capacity, &mut written);
@@ -606,10 +609,10 @@ impl World {
             return Ok(());
         }
         let mut def = kdw_engine_def_default();
-        if c.pick2 % 4 == 0 {
+        if c.pick2.is_multiple_of(4) {
             def.substep_rate = c.f[0] * 1000.0;
         }
-        if c.pick2 % 9 == 0 {
+        if c.pick2.is_multiple_of(9) {
             def.struct_size = c.n;
         }
         let mut engine = null_mut();

@@ -222,7 +222,7 @@ impl SolveMemory {
 
     /// Whether the next first solve starts with the exact projection.
     pub fn wants_exact(&self) -> bool {
-        self.exact_streak % RETRY_DIRECT != 0
+        !self.exact_streak.is_multiple_of(RETRY_DIRECT)
     }
 
     /// `self = other`, in the room `self` has (no allocation once it has held a chain of that length). The

@@ -218,12 +218,16 @@ impl LaneSolver {
             let same = rest.iter().take_while(|j| j.key() == first.key()).count();
             let (mut run, tail) = rest.split_at(same);
             rest = tail;
-            for (count, width) in group_widths(same, sixteen) {
+            let mut widths = group_widths(same, sixteen).peekable();
+            while let Some((count, width)) = widths.next() {
                 let (group, remaining) = run.split_at(count);
                 run = remaining;
-                // The next group's chains arrive while this one runs.
-                let next = if run.is_empty() { rest } else { run };
-                prefetch::chains_of(chains, &next[..next.len().min(width)]);
+                // The next group's chains arrive while this one runs (the first group of the next run: at most 16).
+                let (next, ahead) = match widths.peek() {
+                    Some(&(next_count, _)) => (run, next_count),
+                    None => (rest, 16),
+                };
+                prefetch::chains_of(chains, &next[..next.len().min(ahead)]);
                 let (group_fallbacks, group_pairs) = match (width, portable) {
                     (16, _) => run_group(&mut self.g16, chains, group, clock, reach, &WIDE16),
                     (8, false) => run_group(&mut self.g8, chains, group, clock, reach, &WIDE8),

@@ -115,6 +115,11 @@ impl<const L: usize> Default for Mask<L> {
     }
 }
 
+/// Capacity for `total` elements, counted from zero rather than from the current length.
+fn reserve_total<T>(v: &mut Vec<T>, total: usize) {
+    v.reserve(total.saturating_sub(v.len()));
+}
+
 impl<const L: usize> LaneGroup<L> {
     /// Sizes the buffers for `settings` (allocates only when they grow).
     pub(crate) fn begin(&mut self, settings: GroupSettings) {
@@ -160,11 +165,14 @@ impl<const L: usize> LaneGroup<L> {
             self.contacts.resize_with(L, LaneContacts::default);
         }
         self.contact_lanes = Mask([false; L]);
-        self.lane_x.reserve(n);
-        self.lane_scratch.reserve(n);
-        self.lane_p.reserve(n);
-        self.lane_lengths.reserve(n);
-        self.lane_mu.reserve(n);
+        // Room for `n` in all, whatever a lane left in them: `Vec::reserve(n)` counts from the length, and
+        // these keep the length of their last use, so it grew them again on every group's first step after
+        // one of its lanes had used them (a heap allocation in a later frame, seen on 16384 x 16).
+        reserve_total(&mut self.lane_x, n);
+        reserve_total(&mut self.lane_scratch, n);
+        reserve_total(&mut self.lane_p, n);
+        reserve_total(&mut self.lane_lengths, n);
+        reserve_total(&mut self.lane_mu, n);
         self.memories.resize_with(L, SolveMemory::default);
         self.constraints.reserve(n);
         self.segment_bounds.reserve(n);
@@ -302,5 +310,51 @@ impl<const L: usize> LaneGroup<L> {
             current[j] = transform(&self.local_current[j]);
             output[j] = transform(&self.output[j]);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{GroupSettings, LaneGroup};
+    use glam::DVec3;
+
+    fn settings(joints: usize) -> GroupSettings {
+        GroupSettings { joints, h: 1.0 / 240.0, iterations: 2, shape_matching: true, substeps: 4 }
+    }
+
+    /// The lane scratch as the contact pass and the scalar fallback leave it: full to the chain's length.
+    fn use_lane_scratch(g: &mut LaneGroup<8>, n: usize) {
+        g.lane_x.resize(n, DVec3::ONE);
+        g.lane_scratch.resize(n, DVec3::ONE);
+        g.lane_p.resize(n, DVec3::ONE);
+        g.lane_lengths.resize(n - 1, 1.0);
+        g.lane_mu.resize(n - 1, 1.0);
+    }
+
+    fn capacities(g: &LaneGroup<8>) -> [usize; 5] {
+        [
+            g.lane_x.capacity(),
+            g.lane_scratch.capacity(),
+            g.lane_p.capacity(),
+            g.lane_lengths.capacity(),
+            g.lane_mu.capacity(),
+        ]
+    }
+
+    #[test]
+    fn a_group_that_was_used_begins_again_without_growing() {
+        let mut g = LaneGroup::<8>::default();
+        g.begin(settings(16));
+        let sized = capacities(&g);
+        assert!(sized.iter().all(|&c| c >= 16), "room for a lane of 16 joints: {sized:?}");
+        use_lane_scratch(&mut g, 16);
+        assert_eq!(capacities(&g), sized, "a lane's use fits in what begin reserved");
+        for joints in [16, 8, 16] {
+            g.begin(settings(joints));
+            assert_eq!(capacities(&g), sized, "begin({joints}) after a use");
+            use_lane_scratch(&mut g, joints);
+        }
+        g.begin(settings(32));
+        assert!(capacities(&g).iter().all(|&c| c >= 32), "grows for longer chains");
     }
 }

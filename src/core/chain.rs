@@ -134,6 +134,8 @@ impl Chain {
         chain.update_rest(None);
         chain.rest_used.clone_from(&chain.rest);
         chain.rest_changed = false;
+        // Built here rather than by the first step, which may come long after (a chain created disabled).
+        chain.refresh_rest_groups();
         chain.write_output(0.0);
         Ok(chain)
     }
@@ -179,6 +181,13 @@ impl Chain {
         }
         let shape = Shape::from_joints(joints)?;
         Ok(EncodedShape::encode(&shape, self.frame.reference))
+    }
+
+    /// Adds a view shape, with room for its blend weight (reserved here so that no step allocates it).
+    pub(crate) fn push_view(&mut self, view: ViewShape) {
+        self.views.push(view);
+        self.weights.reserve(self.views.len().saturating_sub(self.weights.len()));
+        self.mark_shapes_dirty();
     }
 
     pub(crate) fn mark_shapes_dirty(&mut self) {

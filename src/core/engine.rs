@@ -1,17 +1,19 @@
 //! The engine: one per character. Owns chains and view shapes, the clock, and the solver scratch; one
 //! `step` advances every chain.
 
+use std::collections::BTreeMap;
 use std::hash::{Hash, Hasher};
 use std::sync::atomic::{AtomicU16, Ordering};
 
 use glam::{Quat, Vec3};
 
 use super::arena::{Arena, Id, Kind};
+use super::buffers::reserve_total;
 use super::chain::{Chain, ViewShape, ViewShapeId, output_fraction, relative_rotation, same_bits};
 use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderSweep};
 use super::collision::ContactInput;
 use super::error::{Error, Result};
-use super::lanes::{Clock, LaneJob, LaneSolver, Solver};
+use super::lanes::{Clock, FEWEST_IN_A_GROUP, LaneJob, LaneSolver, Solver};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
 use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, TeleportMode};
 use super::reach::Reach;
@@ -142,6 +144,8 @@ pub struct Engine {
     lane_jobs: Vec<LaneJob>,
     lane_leftovers: Vec<LaneJob>,
     progress: Vec<f32>,
+    /// How many chains the engine holds of each joint count: what the step's buffers are sized for.
+    chains_by_joints: BTreeMap<usize, usize>,
     stats: Stats,
 }
 
@@ -159,7 +163,7 @@ impl Engine {
     pub fn new(settings: EngineSettings) -> Result<Self> {
         settings.validate()?;
         let salt = NEXT_SALT.fetch_add(1, Ordering::Relaxed);
-        Ok(Self {
+        let mut engine = Self {
             settings,
             chains: Arena::new(Kind::Chain, salt),
             order: Vec::new(),
@@ -179,8 +183,37 @@ impl Engine {
             lane_jobs: Vec::new(),
             lane_leftovers: Vec::new(),
             progress: Vec::new(),
+            chains_by_joints: BTreeMap::new(),
             stats: Stats::default(),
-        })
+        };
+        engine.reserve_step_buffers();
+        Ok(engine)
+    }
+
+    /// Sizes the step's buffers for the chains and colliders the engine holds and for `max_substeps`, so
+    /// that no step allocates however its work changes (a longer chain enabled or woken, a slow frame's
+    /// extra substeps, chains moving between lane groups and the scalar solver as others sleep). Called
+    /// whenever one of those grows; buffers only grow.
+    fn reserve_step_buffers(&mut self) {
+        let substeps = self.settings.max_substeps as usize;
+        let colliders = self.collider_order.len();
+        let chains = self.order.len();
+        let longest = self.chains_by_joints.keys().next_back().copied().unwrap_or(0);
+        self.scratch.reserve(longest);
+        let contacts = &mut self.contact_scratch;
+        reserve_total(&mut contacts.radii, longest);
+        reserve_total(&mut contacts.candidates, colliders);
+        reserve_total(&mut contacts.chain_sweeps, colliders);
+        reserve_total(&mut self.progress, substeps);
+        reserve_total(&mut self.collider_sweeps, substeps * colliders);
+        reserve_total(&mut self.lane_jobs, chains);
+        reserve_total(&mut self.lane_leftovers, chains);
+        // Lane groups only for joint counts with enough chains to fill one (a single 1000-joint rope never
+        // runs in lanes, and 16 lanes of it would take megabytes).
+        let grouped = self.chains_by_joints.iter().rev().find(|&(_, &count)| count >= FEWEST_IN_A_GROUP);
+        if let Some((&joints, _)) = grouped {
+            self.lanes.reserve(joints, substeps, colliders);
+        }
     }
 
     pub fn settings(&self) -> &EngineSettings {
@@ -190,6 +223,7 @@ impl Engine {
     pub fn set_settings(&mut self, settings: EngineSettings) -> Result<()> {
         settings.validate()?;
         self.settings = settings;
+        self.reserve_step_buffers();
         self.wake_all();
         Ok(())
     }
@@ -245,6 +279,8 @@ impl Engine {
         let id = self.chains.insert(chain).expect("room checked above");
         self.order.push(self.chains.index_of(id).expect("just inserted") as u32);
         self.joint_count += n;
+        *self.chains_by_joints.entry(n).or_default() += 1;
+        self.reserve_step_buffers();
         Ok(id)
     }
 
@@ -275,6 +311,12 @@ impl Engine {
         }
         self.order.retain(|&slot| slot as usize != index);
         self.joint_count -= chain.joint_count();
+        if let Some(count) = self.chains_by_joints.get_mut(&chain.joint_count()) {
+            *count -= 1;
+            if *count == 0 {
+                self.chains_by_joints.remove(&chain.joint_count());
+            }
+        }
         Ok(())
     }
 
@@ -419,6 +461,7 @@ impl Engine {
         let id = self.colliders.insert(Collider::new(def, pose)).expect("room checked above");
         self.wake_all();
         self.collider_order.push(self.colliders.index_of(id).expect("just inserted") as u32);
+        self.reserve_step_buffers();
         Ok(Id::from_bits(id.to_bits()))
     }
 
@@ -507,8 +550,7 @@ impl Engine {
         }
         let id = Id::from_bits(self.view_shapes.insert(slot as u32).expect("room checked").to_bits());
         let chain = self.chains.at_mut(slot).expect("checked");
-        chain.views.push(ViewShape { id, weighting: ViewWeighting { direction, influence }, encoded });
-        chain.mark_shapes_dirty();
+        chain.push_view(ViewShape { id, weighting: ViewWeighting { direction, influence }, encoded });
         Ok(id)
     }
 

@@ -219,6 +219,19 @@ impl SolveMemory {
         }
     }
 
+    /// Room for a chain of `bonds` bonds, so that [`copy_from`](Self::copy_from) such a chain's memory does
+    /// not allocate.
+    pub fn reserve(&mut self, bonds: usize) {
+        self.tension.reserve(bonds.saturating_sub(self.tension.len()));
+        self.correction.reserve((bonds + 1).saturating_sub(self.correction.len()));
+    }
+
+    /// The most bonds a chain's memory can have for [`copy_from`](Self::copy_from) to fit without allocating.
+    #[cfg(test)]
+    pub fn room(&self) -> usize {
+        self.tension.capacity().min(self.correction.capacity().saturating_sub(1))
+    }
+
     /// Whether the last first solves took the exact projection.
     pub fn in_streak(&self) -> bool {
         self.exact_streak > 0

@@ -9,11 +9,13 @@
 //! - [`collider`], [`collision`]: colliders and the contact pass (3.7)
 //! - [`batch`]: many engines in one call (optionally on a thread pool)
 //! - [`params`]: settings, parameters, units
+//! - [`buffers`]: reusable buffers sized before the steps that fill them
 //! - [`arena`], [`chain`], [`engine`]: objects, ids and the stepping loop (3.5, 3.6, 3.9)
 
 pub mod arena;
 pub mod batch;
 pub mod blend;
+pub(crate) mod buffers;
 pub mod chain;
 pub mod collider;
 pub mod collision;

@@ -160,7 +160,8 @@ pub struct RodScratch {
 }
 
 impl RodScratch {
-    fn reserve(&mut self, n: usize) {
+    /// Room for a chain of `n` joints.
+    pub(crate) fn reserve(&mut self, n: usize) {
         if self.p.len() < n {
             self.p.resize(n, DVec3::ZERO);
             self.qp.resize(n, Quat::IDENTITY);

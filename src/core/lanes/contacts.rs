@@ -7,6 +7,7 @@ use glam::DVec3;
 
 use super::group::LaneGroup;
 use super::simd::{DV3, Mask};
+use crate::core::buffers::reserve_total;
 use crate::core::collider::ColliderSweep;
 use crate::core::collision::{self, ContactInput, ContactPass};
 use crate::core::inextensible;
@@ -35,6 +36,14 @@ pub(crate) struct LaneContacts {
 }
 
 impl LaneContacts {
+    /// Room for a chain of `joints` joints that may touch `colliders` colliders.
+    pub(super) fn reserve(&mut self, joints: usize, colliders: usize) {
+        reserve_total(&mut self.radii, joints);
+        reserve_total(&mut self.lengths, joints.saturating_sub(1));
+        reserve_total(&mut self.candidates, colliders);
+        reserve_total(&mut self.sweeps, colliders);
+    }
+
     fn input(&self) -> ContactInput<'_> {
         ContactInput {
             colliders: &self.sweeps,

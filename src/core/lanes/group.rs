@@ -5,6 +5,7 @@ use glam::{DVec3, Quat, Vec3, Vec3A};
 
 use super::contacts::LaneContacts;
 use super::simd::{D, DV3, F, Mask, Q, V3};
+use crate::core::buffers::reserve_total;
 use crate::core::collider::ColliderSweep;
 use crate::core::collision::SegmentBounds;
 use crate::core::inextensible::{ConstraintScratch, SolveMemory};
@@ -115,19 +116,23 @@ impl<const L: usize> Default for Mask<L> {
     }
 }
 
-/// Capacity for `total` elements, counted from zero rather than from the current length.
-fn reserve_total<T>(v: &mut Vec<T>, total: usize) {
-    v.reserve(total.saturating_sub(v.len()));
-}
-
 impl<const L: usize> LaneGroup<L> {
-    /// Sizes the buffers for `settings` (allocates only when they grow).
+    /// Sizes the buffers for `settings` (allocates only when they grow: see [`reserve`](Self::reserve)).
     pub(crate) fn begin(&mut self, settings: GroupSettings) {
-        let n = settings.joints;
-        self.n = n;
+        self.reserve(settings.joints, settings.substeps, 0);
+        self.n = settings.joints;
         self.h = settings.h;
         self.iterations = settings.iterations;
         self.shape_matching = settings.shape_matching;
+        self.substeps = settings.substeps;
+        self.contact_lanes = Mask([false; L]);
+    }
+
+    /// Room for a group of chains of `joints` joints over `substeps` substeps, each touching up to
+    /// `colliders` colliders, so that no step that fits allocates (the engine reserves it when it learns of
+    /// such chains; `begin` when a step meets more).
+    pub(crate) fn reserve(&mut self, joints: usize, substeps: usize, colliders: usize) {
+        let n = joints;
         fn fit<T: Clone>(v: &mut Vec<T>, len: usize, value: T) {
             if v.len() < len {
                 v.resize(len, value);
@@ -155,25 +160,30 @@ impl<const L: usize> LaneGroup<L> {
         ] {
             fit(v, n, D([0.0; L]));
         }
-        fit(&mut self.anchors, settings.substeps, (V3::ZERO, zero_q));
+        fit(&mut self.anchors, substeps, (V3::ZERO, zero_q));
         for v in [&mut self.local_previous, &mut self.local_current, &mut self.output] {
             fit(v, n, (V3::ZERO, zero_q));
         }
         fit(&mut self.bone_axes, n, V3::ZERO);
-        self.substeps = settings.substeps;
         if self.contacts.len() < L {
             self.contacts.resize_with(L, LaneContacts::default);
         }
-        self.contact_lanes = Mask([false; L]);
-        // Room for `n` in all, whatever a lane left in them: `Vec::reserve(n)` counts from the length, and
-        // these keep the length of their last use, so it grew them again on every group's first step after
-        // one of its lanes had used them (a heap allocation in a later frame, seen on 16384 x 16).
+        // Per lane, room for a chain of this length, whichever chain lands in the lane (which lane a chain
+        // takes changes from step to step as others sleep, wake or come within reach of a collider).
+        for contact in &mut self.contacts {
+            contact.reserve(n, colliders);
+        }
+        // The lane scratch keeps the length of its last use (a fallback's or a contact pass's lane): counted
+        // from zero, or every group's first step after such a use grew it again.
         reserve_total(&mut self.lane_x, n);
         reserve_total(&mut self.lane_scratch, n);
         reserve_total(&mut self.lane_p, n);
         reserve_total(&mut self.lane_lengths, n);
         reserve_total(&mut self.lane_mu, n);
         self.memories.resize_with(L, SolveMemory::default);
+        for memory in &mut self.memories {
+            memory.reserve(n.saturating_sub(1));
+        }
         self.constraints.reserve(n);
         self.segment_bounds.reserve(n);
     }
@@ -356,5 +366,19 @@ mod tests {
         }
         g.begin(settings(32));
         assert!(capacities(&g).iter().all(|&c| c >= 32), "grows for longer chains");
+    }
+
+    #[test]
+    fn every_lane_has_room_for_a_chain_of_the_group_length() {
+        let mut g = LaneGroup::<8>::default();
+        for joints in [4, 16, 8, 32] {
+            g.begin(settings(joints));
+            for lane in 0..8 {
+                let contact = &g.contacts[lane];
+                assert!(contact.radii.capacity() >= joints, "radii, lane {lane}, {joints} joints");
+                assert!(contact.lengths.capacity() >= joints - 1, "lengths, lane {lane}, {joints} joints");
+                assert!(g.memories[lane].room() >= joints - 1, "solve memory, lane {lane}, {joints} joints");
+            }
+        }
     }
 }

@@ -155,6 +155,9 @@ pub struct LaneSolver {
     g4: LaneGroup<4>,
 }
 
+/// The fewest chains of one kind (joint count, limp or not) that [`group_widths`] puts in a lane group.
+pub(crate) const FEWEST_IN_A_GROUP: usize = 3;
+
 /// How a run of `len` chains of one kind is cut into lane groups: full groups of 16 where the CPU has AVX-512
 /// (`sixteen`), full groups of 8, then the rest as one group of 8 or 4 whose spare lanes repeat a chain of the
 /// group (computed, never stored), or on the scalar solver. Measured in instructions (callgrind, `step_cost 4
@@ -172,13 +175,23 @@ fn group_widths(len: usize, sixteen: bool) -> impl Iterator<Item = (usize, usize
     let full = rest / 8;
     let tail = match rest % 8 {
         rest @ 5..=7 => Some((rest, 8)),
-        rest @ 3..=4 => Some((rest, 4)),
+        rest @ FEWEST_IN_A_GROUP..=4 => Some((rest, 4)),
         _ => None,
     };
     std::iter::repeat_n((16, 16), sixteens).chain(std::iter::repeat_n((8, 8), full)).chain(tail)
 }
 
 impl LaneSolver {
+    /// Room for lane groups of chains of `joints` joints over up to `substeps` substeps, touching up to
+    /// `colliders` colliders, in every width this CPU runs (`LaneGroup::reserve`).
+    pub(crate) fn reserve(&mut self, joints: usize, substeps: usize, colliders: usize) {
+        if has_avx512() {
+            self.g16.reserve(joints, substeps, colliders);
+        }
+        self.g8.reserve(joints, substeps, colliders);
+        self.g4.reserve(joints, substeps, colliders);
+    }
+
     /// Runs every substep of the step for the chains of `jobs` (reordered by joint count) that go into lane
     /// groups ([`group_widths`]), and moves the others to `leftovers` for the scalar solver. Returns the
     /// substeps, summed over the chains, in which the direct inextensibility solve fell back, and the contact
@@ -471,12 +484,14 @@ fn run_group<const L: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::group_widths;
+    use super::{FEWEST_IN_A_GROUP, group_widths};
 
     #[test]
     fn runs_are_cut_into_groups_of_16_only_where_the_kernel_has_them() {
         let cut = |len, sixteen| group_widths(len, sixteen).collect::<Vec<_>>();
         assert_eq!(cut(2, true), []);
+        assert_eq!(cut(FEWEST_IN_A_GROUP - 1, false), []);
+        assert_eq!(cut(FEWEST_IN_A_GROUP, false), [(FEWEST_IN_A_GROUP, 4)]);
         assert_eq!(cut(16, false), [(8, 8), (8, 8)]);
         assert_eq!(cut(16, true), [(16, 16)]);
         assert_eq!(cut(29, true), [(16, 16), (8, 8), (5, 8)]);

@@ -1,37 +1,14 @@
 //! Hot loops allocate nothing (SPEC 6.3, issue 5): after a warm-up, a frame (anchors, collider poses, step
 //! with view shapes and colliders, read-back) makes no heap allocation, through the Rust API and through the C
-//! ABI. A counting global allocator measures it; this file holds one test so nothing else runs meanwhile.
+//! ABI. A counting global allocator (`common::counting`) measures it; this file holds one test so nothing
+//! else runs meanwhile.
 
 mod common;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
+use common::counting::{Counting, allocations};
 use common::*;
 use glam::{Quat, Vec3};
 use kodawari::{AnchorSource, ChainParams, ColliderDef, ColliderShape, Engine, EngineSettings, Transform};
-
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator unchanged; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: the caller's contract, passed on.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: the caller's contract, passed on.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: the caller's contract, passed on.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -102,11 +79,11 @@ fn a_frame_allocates_nothing() {
     for n in 0..30 {
         frame(&mut engine, n, &mut anchors, &mut out, &mut rotations);
     }
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = allocations();
     for n in 30..330 {
         frame(&mut engine, n, &mut anchors, &mut out, &mut rotations);
     }
-    let rust_allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+    let rust_allocations = allocations() - before;
     assert_eq!(engine.stats().lane_chains, 8, "eight of the nine equal chains form a lane group");
     assert!(engine.stats().contact_pairs_tested > 0);
 
@@ -142,11 +119,11 @@ fn a_frame_allocates_nothing() {
     for n in 0..30 {
         c_frame(n);
     }
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = allocations();
     for n in 30..330 {
         c_frame(n);
     }
-    let c_allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+    let c_allocations = allocations() - before;
 
     // Several engines in one batch call (serial build; the thread pool's own bookkeeping is rayon's).
     let handles: Vec<*mut kdw_engine> = (0..4)
@@ -168,11 +145,11 @@ fn a_frame_allocates_nothing() {
     for n in 0..30 {
         batch_frame(n);
     }
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = allocations();
     for n in 30..330 {
         batch_frame(n);
     }
-    let batch_allocations = if cfg!(feature = "parallel") { 0 } else { ALLOCATIONS.load(Ordering::Relaxed) - before };
+    let batch_allocations = if cfg!(feature = "parallel") { 0 } else { allocations() - before };
     for e in handles.into_iter().chain([handle]) {
         assert_eq!(kdw_engine_destroy(e), 0);
     }

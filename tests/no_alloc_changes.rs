@@ -2,39 +2,15 @@
 //! longer than any stepped so far are enabled, chains move between lane groups and the scalar solver as others
 //! are disabled, a slow frame needs the most substeps, and a fine rope's solver falls back. Buffers sized by
 //! what a step happens to meet would grow on the first such frame, long after the warm-up; they are sized
-//! when chains are created instead. A counting global allocator measures it; this file holds one test so
-//! nothing else runs meanwhile.
+//! when chains are created instead. A counting global allocator (`common::counting`) measures it; this file
+//! holds one test so nothing else runs meanwhile.
 
 mod common;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
+use common::counting::{Counting, allocations};
 use common::*;
 use glam::{Quat, Vec3};
 use kodawari::{ChainId, ChainParams, ColliderDef, ColliderShape, Engine, EngineSettings, Transform};
-
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator unchanged; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: the caller's contract, passed on.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: the caller's contract, passed on.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-        // SAFETY: the caller's contract, passed on.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -85,14 +61,14 @@ fn a_step_allocates_nothing_when_what_it_runs_changes() {
         frame(&mut engine, n, 1.0 / 60.0);
         engine.read_world(&mut out).unwrap();
     }
-    let mut allocations = Vec::new();
+    let mut allocating_frames = Vec::new();
     let mut counted = |engine: &mut Engine, n: usize, dt: f32, what: &str| {
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        let before = allocations();
         frame(engine, n, dt);
         engine.read_world(&mut out).unwrap();
-        let made = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        let made = allocations() - before;
         if made > 0 {
-            allocations.push(format!("{what} (frame {n}): {made}"));
+            allocating_frames.push(format!("{what} (frame {n}): {made}"));
         }
     };
     let mut n = 30;
@@ -113,5 +89,5 @@ fn a_step_allocates_nothing_when_what_it_runs_changes() {
     }
     assert!(engine.stats().contact_pairs_tested > 0, "the chains touch the head");
     assert!(engine.stats().solver_fallbacks > 0, "the rope's direct solve falls back");
-    assert!(allocations.is_empty(), "{allocations:#?}");
+    assert!(allocating_frames.is_empty(), "{allocating_frames:#?}");
 }

@@ -5,6 +5,7 @@ use glam::{Quat, Vec3};
 
 use super::arena::Id;
 use super::blend::blend_into;
+use super::buffers::reserve_total;
 use super::error::{Error, Result};
 use super::math::{Transform, direction, nlerp_shorter, swing_to};
 use super::params::{ChainParams, EngineSettings, SLEEP_DELAY};
@@ -186,7 +187,7 @@ impl Chain {
     /// Adds a view shape, with room for its blend weight (reserved here so that no step allocates it).
     pub(crate) fn push_view(&mut self, view: ViewShape) {
         self.views.push(view);
-        self.weights.reserve(self.views.len().saturating_sub(self.weights.len()));
+        reserve_total(&mut self.weights, self.views.len());
         self.mark_shapes_dirty();
     }
 

@@ -1,6 +1,8 @@
 //! Scene builders shared by the Rust integration tests.
 #![allow(dead_code)]
 
+pub mod counting;
+
 use glam::{Quat, Vec3};
 use kodawari::{ChainId, ChainParams, Engine, EngineSettings, Transform};
 

@@ -313,39 +313,112 @@ fn chain_created_inside_colliders_is_pushed_out_calmly() {
 /// farther along still clear the sphere.
 #[test]
 fn joints_the_root_holds_inside_a_collider_keep_their_lengths() {
-    let mut engine = engine_with(EngineSettings::default());
-    let (sphere_radius, joint_radius, segment) = (0.085f32, 0.02f32, 0.004f32);
-    // Root 9 mm inside the reach (sphere + joint radius). The chain is given in the anchor's frame, which is
-    // at the sphere's centre.
-    let depth = 0.009f32;
-    let root = Vec3::X * (sphere_radius + joint_radius - depth);
-    let base = straight_chain(16, root, Vec3::new(0.3, -1.0, 0.0), segment);
-    let params = ChainParams { stiffness: 0.0, radius: joint_radius, damping: 2.0, ..Default::default() };
-    let id = engine.create_chain(params, &base).unwrap();
-    let def = ColliderDef { shape: ColliderShape::Sphere { radius: sphere_radius }, transform: at(HEAD), layers: 1 };
-    engine.create_collider(&def).unwrap();
-    let (mut worst_stretch, mut worst_free_depth, mut last_stretch) = (0.0f32, f32::NEG_INFINITY, 0.0);
-    for _ in 0..120 {
-        engine.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
-        let points = particles(&engine, id);
-        let stretch = points.windows(2).map(|w| ((w[1] - w[0]).length() / segment - 1.0).abs());
-        last_stretch = stretch.fold(0.0, f32::max);
-        worst_stretch = worst_stretch.max(last_stretch);
-        // Joints at least twice the root's depth along the chain can clear the sphere with room to spare.
-        let free = points.iter().enumerate().filter(|(j, _)| *j as f32 * segment >= 2.0 * depth);
-        let depths = free.map(|(_, p)| sphere_radius + joint_radius - (*p - HEAD).length());
-        worst_free_depth = depths.fold(worst_free_depth, f32::max);
-    }
-    let stats = engine.stats();
-    println!(
-        "root held inside: max stretch {worst_stretch:.2e} (last frame {last_stretch:.2e}), deepest free joint \
-         {worst_free_depth:.2e} m, {} solver fallbacks in {} substeps",
-        stats.solver_fallbacks, stats.substeps_total
-    );
+    let held = RootedInside { joints: 16, segment: 0.004, depth: 0.009 }.run();
+    println!("root held inside, 16 joints: {held}");
     // The segment from the last joint left inside to the first pushed out meets both the contact and the
     // lengths: while the chain swings, its stretch is what a chain pressed on a collider shows (1.7e-3 measured).
-    assert!(worst_stretch <= 5e-3, "stretch {worst_stretch}");
-    assert!(last_stretch <= 1e-4, "stretch at the end {last_stretch}");
-    assert!(stats.solver_fallbacks * 20 <= stats.substeps_total, "{} fallbacks", stats.solver_fallbacks);
-    assert!(worst_free_depth <= 1e-4, "a joint that can clear the sphere is {worst_free_depth} m inside");
+    held.assert_within(5e-3);
+}
+
+/// Bug 9 (docs/robustness.md): the chain above, only longer, so that it hangs by its weight along the sphere.
+/// Its first joint past the held ones lies inside the sphere with the chain pulled taut from the root; every
+/// contact round pushes it out and the lengths solve (the exact projection, which moves every joint as little
+/// as it can, so the short run to the root rather than the long tail) pulls it back by nearly as much. The
+/// rounds never settle (all 16 run on every substep, which is what makes the performance report's 1 x 256 and
+/// 1 x 1000 ropes with colliders cost 12 to 18 times their plain frame) and the substeps end with that segment
+/// stretched: up to 2.2e-2 for 64 joints of 4 mm, 5.5e-2 for 257 joints of 3.1 mm (1.1e-2 and 3.1e-2 in the
+/// last frame), where the 16-joint chain above shows 1.7e-3 and 7.8e-5.
+#[test]
+#[ignore = "BUG 9: a rope rooted inside a collider's reach ends every substep stretched where it leaves the held joints"]
+fn a_long_rope_rooted_inside_a_collider_keeps_its_lengths() {
+    let ropes = [
+        RootedInside { joints: 64, segment: 0.004, depth: 0.009 },
+        RootedInside { joints: 257, segment: 0.003125, depth: 0.005 },
+    ];
+    let runs = ropes.map(|rope| {
+        let held = rope.run();
+        println!("root held inside, {} joints of {} m: {held}", rope.joints, rope.segment);
+        held
+    });
+    for held in runs {
+        held.assert_within(5e-3);
+    }
+}
+
+/// A limp, damped chain whose root lies `depth` inside the reach of a head sphere (its radius plus the joint
+/// radius), released straight at 73 degrees from the sphere's outward normal, run for 2 s.
+#[derive(Clone, Copy)]
+struct RootedInside {
+    joints: usize,
+    segment: f32,
+    depth: f32,
+}
+
+impl RootedInside {
+    fn run(self) -> HeldRun {
+        let RootedInside { joints, segment, depth } = self;
+        let mut engine = engine_with(EngineSettings::default());
+        let (sphere_radius, joint_radius) = (0.085f32, 0.02f32);
+        // The chain is given in the anchor's frame, which is at the sphere's centre.
+        let root = Vec3::X * (sphere_radius + joint_radius - depth);
+        let base = straight_chain(joints, root, Vec3::new(0.3, -1.0, 0.0), segment);
+        let params = ChainParams { stiffness: 0.0, radius: joint_radius, damping: 2.0, ..Default::default() };
+        let id = engine.create_chain(params, &base).unwrap();
+        let def =
+            ColliderDef { shape: ColliderShape::Sphere { radius: sphere_radius }, transform: at(HEAD), layers: 1 };
+        engine.create_collider(&def).unwrap();
+        let mut run = HeldRun {
+            worst_stretch: 0.0,
+            last_stretch: 0.0,
+            worst_free_depth: f32::NEG_INFINITY,
+            fallbacks: 0,
+            substeps: 0,
+        };
+        for _ in 0..120 {
+            engine.step(1.0 / 60.0, CAMERA, at(HEAD)).unwrap();
+            let points = particles(&engine, id);
+            let stretch = points.windows(2).map(|w| ((w[1] - w[0]).length() / segment - 1.0).abs());
+            run.last_stretch = stretch.fold(0.0, f32::max);
+            run.worst_stretch = run.worst_stretch.max(run.last_stretch);
+            // Joints at least twice the root's depth along the chain can clear the sphere with room to spare.
+            let free = points.iter().enumerate().filter(|(j, _)| *j as f32 * segment >= 2.0 * depth);
+            let depths = free.map(|(_, p)| sphere_radius + joint_radius - (*p - HEAD).length());
+            run.worst_free_depth = depths.fold(run.worst_free_depth, f32::max);
+        }
+        let stats = engine.stats();
+        (run.fallbacks, run.substeps) = (stats.solver_fallbacks, stats.substeps_total);
+        run
+    }
+}
+
+/// What [`RootedInside::run`] measured.
+struct HeldRun {
+    worst_stretch: f32,
+    last_stretch: f32,
+    worst_free_depth: f32,
+    fallbacks: u64,
+    substeps: u64,
+}
+
+impl HeldRun {
+    fn assert_within(&self, swinging_stretch: f32) {
+        assert!(self.worst_stretch <= swinging_stretch, "stretch {}", self.worst_stretch);
+        assert!(self.last_stretch <= 1e-4, "stretch at the end {}", self.last_stretch);
+        assert!(self.fallbacks * 20 <= self.substeps, "{} fallbacks", self.fallbacks);
+        assert!(
+            self.worst_free_depth <= 1e-4,
+            "a joint that can clear the sphere is {} m inside",
+            self.worst_free_depth
+        );
+    }
+}
+
+impl std::fmt::Display for HeldRun {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "max stretch {:.2e} (last frame {:.2e}), deepest free joint {:.2e} m, {} solver fallbacks in {} substeps",
+            self.worst_stretch, self.last_stretch, self.worst_free_depth, self.fallbacks, self.substeps
+        )
+    }
 }

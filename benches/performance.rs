@@ -34,8 +34,7 @@ use std::time::{Duration, Instant};
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, measurement::WallTime};
 use peer_pendulum::{KodawariPendulum, Reference};
 use perf_report::{
-    Bound, CountingAllocator, Machine, PairedRatio, PeerRow, Recorder, Report, SceneRow, Skip, Target, micros,
-    paired_ratio,
+    Bound, Counting, Machine, PairedRatio, PeerRow, Recorder, Report, SceneRow, Skip, Target, micros, paired_ratio,
 };
 use scene_ffi::{FfiFrame, FfiSceneRun};
 use scenes::{
@@ -44,7 +43,7 @@ use scenes::{
 };
 
 #[global_allocator]
-static ALLOCATOR: CountingAllocator = CountingAllocator;
+static ALLOCATOR: Counting = Counting;
 
 /// The solver path that ran: the lane solver (the default) with the kernel `kodawari::simd_path` reports for
 /// this CPU (contacts scalar, lane by lane), and the scalar solver for the few left over from the lane groups.

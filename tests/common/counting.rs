@@ -1,6 +1,7 @@
 //! A global allocator that counts heap allocations (and reallocations): the no-allocation tests install it
 //! with `#[global_allocator] static GLOBAL: Counting = Counting;` and hold one test per file, so nothing
-//! else allocates meanwhile.
+//! else allocates meanwhile; the performance report (`benches/support/perf_report.rs`) includes this file
+//! for its allocations per frame.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};

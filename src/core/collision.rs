@@ -9,6 +9,7 @@
 
 use glam::{DVec3, Vec3};
 
+use super::buffers::reserve_total;
 use super::collider::{ColliderShape, ColliderSweep};
 
 /// Below this share of a root segment's length from its kinematic end, a contact cannot be resolved by
@@ -63,7 +64,7 @@ pub struct SegmentBounds {
 
 impl SegmentBounds {
     pub fn reserve(&mut self, segments: usize) {
-        self.bounds.reserve(segments.saturating_sub(self.bounds.len()));
+        reserve_total(&mut self.bounds, segments);
     }
 
     fn compute(&mut self, start: &[DVec3], p: &[DVec3], radii: &[f32]) {

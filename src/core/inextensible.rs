@@ -6,6 +6,7 @@
 
 use glam::DVec3;
 
+use super::buffers::reserve_total;
 use super::implicit::{self, ImplicitScratch};
 
 /// Relative error of `|b|^2 / l^2 - 1` below which a bond counts as satisfied: 5e-8 in length, the float32
@@ -222,8 +223,8 @@ impl SolveMemory {
     /// Room for a chain of `bonds` bonds, so that [`copy_from`](Self::copy_from) such a chain's memory does
     /// not allocate.
     pub fn reserve(&mut self, bonds: usize) {
-        self.tension.reserve(bonds.saturating_sub(self.tension.len()));
-        self.correction.reserve((bonds + 1).saturating_sub(self.correction.len()));
+        reserve_total(&mut self.tension, bonds);
+        reserve_total(&mut self.correction, bonds + 1);
     }
 
     /// The most bonds a chain's memory can have for [`copy_from`](Self::copy_from) to fit without allocating.

@@ -8,7 +8,8 @@
 //! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair), `lod1` and `lod2`, `views`
 //! (three view shapes per chain, orbiting camera). It also prints the
 //! engine's state hash and the contact pairs tested, so that two builds can be checked to compute the same
-//! bits on a scene.
+//! bits on a scene, and last the mean time of a frame, for `tools/ab.sh` (interleaved timing of two builds:
+//! `tools/ab.sh OLD NEW 20 200 100x16 views`).
 
 #[path = "../benches/support/scenes.rs"]
 mod scenes;
@@ -45,9 +46,11 @@ fn main() {
     if let Some(note) = run.settle() {
         println!("{note}");
     }
+    let start = std::time::Instant::now();
     for _ in 0..frames {
         run.frame();
     }
+    let frame_time = start.elapsed().as_nanos() as f64 / frames.max(1) as f64;
     let stats = run.engine.stats();
     println!("hash {:016x} pairs {}", run.engine.state_hash(), stats.contact_pairs_tested);
     println!(
@@ -59,4 +62,6 @@ fn main() {
         stats.substeps_total,
         stats.solver_fallbacks
     );
+    // Last, in the form `tools/ab.sh` reads, for interleaved timing of two builds.
+    println!("frame {frame_time:.0} ns");
 }

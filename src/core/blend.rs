@@ -15,18 +15,26 @@ where
     blend_quats(&base.orientations, w0, views.map(|(s, w)| (&s.orientations[..], w)), &mut out.orientations);
 }
 
-fn blend_quats<'a>(base: &[Quat], w0: f32, views: impl Iterator<Item = (&'a [Quat], f32)> + Clone, out: &mut [Quat]) {
-    for (j, (reference, slot)) in base.iter().zip(out.iter_mut()).enumerate() {
-        let mut sum = *reference * w0;
-        for (view, w) in views.clone() {
-            if w > 0.0 {
-                sum += align_hemisphere(view[j], *reference) * w;
+fn blend_quats<'a>(base: &[Quat], w0: f32, views: impl Iterator<Item = (&'a [Quat], f32)>, out: &mut [Quat]) {
+    let n = base.len().min(out.len());
+    let (base, out) = (&base[..n], &mut out[..n]);
+    // View by view over every joint rather than joint by joint over the views: each pass streams two arrays,
+    // and every joint's sum still adds its terms in the same order (the same bits).
+    for (sum, reference) in out.iter_mut().zip(base) {
+        *sum = *reference * w0;
+    }
+    for (view, w) in views {
+        if w > 0.0 {
+            for ((sum, reference), q) in out.iter_mut().zip(base).zip(&view[..n]) {
+                *sum += align_hemisphere(*q, *reference) * w;
             }
         }
+    }
+    for (slot, reference) in out.iter_mut().zip(base) {
         // Every term lies in the base's hemisphere, so the sum vanishes only when the weights do; the
         // base is the natural fallback.
-        let len = sum.length();
-        *slot = if len > 1e-12 { sum / len } else { *reference };
+        let len = slot.length();
+        *slot = if len > 1e-12 { *slot / len } else { *reference };
     }
 }
 

@@ -294,9 +294,10 @@ pub fn carry_to_new_rest(
     for k in 0..n - 1 {
         let old_segment = anchor.rotation * (old.positions[k + 1] - old.positions[k]);
         let current = (state.x[k + 1] - state.x[k]).as_vec3();
+        // A segment of no length has no direction to carry: it keeps its new rest direction.
         let deformation = match (super::math::direction(old_segment), super::math::direction(current)) {
             (Some(from), Some(to)) => super::math::shortest_arc(from, to),
-            _ => anchor.rotation,
+            _ => Quat::IDENTITY,
         };
         let new_segment = anchor.rotation * (new.positions[k + 1] - new.positions[k]);
         target[k + 1] = target[k] + (deformation * new_segment).as_dvec3();

@@ -125,7 +125,7 @@ fn collide_at(
     pose: Pose,
     bounds: &mut SegmentBounds,
 ) -> ContactPass {
-    let mut result = ContactPass { tested: 0, touching: false, deepest: 0.0 };
+    let mut result = ContactPass { tested: 0, touching: false, deepest: 0.0, moved_start: false };
     let outside =
         |sweep: &ColliderSweep| matches!(sweep.shape, ColliderShape::Sphere { .. } | ColliderShape::Capsule { .. });
     if input.colliders.iter().any(outside) {
@@ -148,6 +148,7 @@ fn collide_at(
         result.tested += pass.tested;
         result.touching |= pass.touching;
         result.deepest = result.deepest.max(pass.deepest);
+        result.moved_start |= pass.moved_start;
     }
     result
 }
@@ -168,6 +169,8 @@ pub struct ContactPass {
     pub touching: bool,
     /// The largest correction made (m).
     pub deepest: f32,
+    /// Some start position was moved too (a joint inside since the start of the substep).
+    pub moved_start: bool,
 }
 
 fn collide_plane(
@@ -179,6 +182,7 @@ fn collide_plane(
 ) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
+    let mut moved_start = false;
     let root_height = sweep.end.to_local(p[0]).y;
     let held = if root_height < input.radii[1] {
         held_by_root(input.lengths, |j, along| root_height + along * CLEARING_SLANT < input.radii[j]).joints
@@ -195,11 +199,12 @@ fn collide_plane(
             let moved = sweep.start.to_local(*start);
             let overlapping_at_start = moved.y < radius - input.slop;
             deepest = deepest.max(depth);
+            moved_start |= overlapping_at_start;
             let contact = Contact { normal: Vec3::Y, depth, overlapping_at_start };
             *drift += contact.push_particle(start, p, sweep, local, moved, input.friction);
         }
     }
-    ContactPass { tested: p.len() as u64 - 1, touching, deepest }
+    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start }
 }
 
 fn collide_inside(
@@ -211,6 +216,7 @@ fn collide_inside(
 ) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
+    let mut moved_start = false;
     let (radius, half_height) = sweep.shape.capsule().expect("inside colliders are capsules");
     let root_distance = distance_from_axis(sweep.end.to_local(p[0]), half_height);
     let held = held_by_root(input.lengths, |j, along| {
@@ -230,11 +236,12 @@ fn collide_inside(
             let overlapping_at_start = (moved - moved_axis_point).length() > limit + input.slop;
             let depth = distance - limit;
             deepest = deepest.max(depth);
+            moved_start |= overlapping_at_start;
             let contact = Contact { normal: -offset / distance, depth, overlapping_at_start };
             *drift += contact.push_particle(&mut start[j], &mut p[j], sweep, local, moved, input.friction);
         }
     }
-    ContactPass { tested: p.len() as u64 - 1, touching, deepest }
+    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start }
 }
 
 fn collide_outside(
@@ -247,6 +254,7 @@ fn collide_outside(
 ) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
+    let mut moved_start = false;
     let (radius, half_height) = sweep.shape.capsule().expect("outside colliders are spheres or capsules");
     let axis = (Vec3::new(0.0, -half_height, 0.0), Vec3::new(0.0, half_height, 0.0));
     // Quick reject, in world space and conservative: a segment whose every point stays farther from the
@@ -304,13 +312,14 @@ fn collide_outside(
         p[k + 1] += world * wb as f64;
         *drift += world.length() * (wa + wb) as f64;
         if overlapping_at_start {
+            moved_start = true;
             let push = sweep.end.direction_to_world(normal * (depth * scale));
             start[k] += push * wa as f64;
             start[k + 1] += push * wb as f64;
             *drift += push.length() * (wa + wb) as f64;
         }
     }
-    ContactPass { tested: p.len() as u64 - 1, touching, deepest }
+    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start }
 }
 
 /// How many of the chain's first dynamic joints the kinematic root holds on the wrong side of a collider's

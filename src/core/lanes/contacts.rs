@@ -117,8 +117,13 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> u64 {
         let pass = collision::collide(lane_x, lane_p, &contact.input(), segment_bounds);
         contact.pass = Some(pass);
         tested += pass.tested;
-        write_back(lane_x, lane, &mut x[..n]);
-        write_back(lane_p, lane, &mut p[..n]);
+        // Only a contact moves positions, and only a joint inside since the start moves start positions.
+        if pass.moved_start {
+            write_back(lane_x, lane, &mut x[..n]);
+        }
+        if pass.touching {
+            write_back(lane_p, lane, &mut p[..n]);
+        }
     }
     tested
 }

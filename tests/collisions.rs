@@ -307,41 +307,43 @@ fn chain_created_inside_colliders_is_pushed_out_calmly() {
 
 /// A hair root inside the head sphere's reach (the scalp lies inside the sphere inflated by the joint
 /// radius) with segments shorter than that overlap: the first joints can clear the sphere only with the
-/// chain pointing nearly straight out from the root, if at all. Those contacts are not made (the lengths
-/// win). Before, they were pushed out every contact round: the segments next to the root ended a substep
-/// stretched by up to 146 %, and the lengths solve failed on all 480 substeps. The joints
-/// farther along still clear the sphere.
+/// chain pointing nearly straight out from the root, if at all. Those joints are not pushed out one by one
+/// (which stretched the segments next to the root by up to 146 % and made the lengths solve fail on all 480
+/// substeps): the contact of the segment leaving them turns them about the root, lengths kept, and the joint
+/// past them slides on the sphere in the contact rounds' lengths solves. The joints farther along clear it.
 #[test]
 fn joints_the_root_holds_inside_a_collider_keep_their_lengths() {
-    let held = RootedInside { joints: 16, segment: 0.004, depth: 0.009 }.run();
+    let held = RootedInside { joints: 16, segment: 0.004, depth: 0.009, sphere: true }.run();
     println!("root held inside, 16 joints: {held}");
-    // The segment from the last joint left inside to the first pushed out meets both the contact and the
-    // lengths: while the chain swings, its stretch is what a chain pressed on a collider shows (1.7e-3 measured).
-    held.assert_within(5e-3);
+    // Measured 2.9e-5 while it swings (1.7e-3 when the held joints stayed put and the next was pushed).
+    held.assert_lengths_and_contacts(1e-4);
+    held.assert_direct_solves();
 }
 
-/// Bug 9 (docs/robustness.md): the chain above, only longer, so that it hangs by its weight along the sphere.
-/// Its first joint past the held ones lies inside the sphere with the chain pulled taut from the root; every
-/// contact round pushes it out and the lengths solve pulls it back by nearly as much (the largest correction
-/// shrinks by 2 to 5 % a round in the performance report's 1 x 1000 rope, temporary prints). The
-/// rounds never settle (all 16 run on every substep, which is what makes the performance report's 1 x 256 and
-/// 1 x 1000 ropes with colliders cost 12 to 18 times their plain frame) and the substeps end with that segment
-/// stretched: up to 2.2e-2 for 64 joints of 4 mm, 5.5e-2 for 257 joints of 3.1 mm (1.1e-2 and 3.1e-2 in the
-/// last frame), where the 16-joint chain above shows 1.7e-3 and 7.8e-5.
+/// Bug 9 (docs/robustness.md, fixed): the chain above, only longer, so that it hangs by its weight along the
+/// sphere. Its first joint past the held ones lay inside the sphere with the chain pulled taut from the root;
+/// every contact round pushed it out and the lengths solve pulled it back by nearly as much, so the rounds
+/// never settled and the substeps ended with that segment stretched: up to 2.2e-2 for 64 joints of 4 mm,
+/// 5.5e-2 for 257 joints of 3.1 mm (1.1e-2 and 3.1e-2 in the last frame). The turn about the root and the
+/// sliding joint settle them (see the test above).
+///
+/// These fine ropes fail the direct lengths solve on most substeps with or without the sphere (bug 1: the
+/// same ropes without it fall back on 290 and 339 of 480 substeps, printed here), so the direct solves are
+/// not asserted for them.
 #[test]
-#[ignore = "BUG 9: a rope rooted inside a collider's reach ends every substep stretched where it leaves the held joints"]
 fn a_long_rope_rooted_inside_a_collider_keeps_its_lengths() {
     let ropes = [
-        RootedInside { joints: 64, segment: 0.004, depth: 0.009 },
-        RootedInside { joints: 257, segment: 0.003125, depth: 0.005 },
+        RootedInside { joints: 64, segment: 0.004, depth: 0.009, sphere: true },
+        RootedInside { joints: 257, segment: 0.003125, depth: 0.005, sphere: true },
     ];
-    let runs = ropes.map(|rope| {
+    for rope in ropes {
         let held = rope.run();
-        println!("root held inside, {} joints of {} m: {held}", rope.joints, rope.segment);
-        held
-    });
-    for held in runs {
-        held.assert_within(5e-3);
+        let alone = RootedInside { sphere: false, ..rope }.run();
+        println!(
+            "root held inside, {} joints of {} m: {held}; without the sphere: {} solver fallbacks",
+            rope.joints, rope.segment, alone.fallbacks
+        );
+        held.assert_lengths_and_contacts(5e-3);
     }
 }
 
@@ -352,11 +354,13 @@ struct RootedInside {
     joints: usize,
     segment: f32,
     depth: f32,
+    /// Whether the sphere is there (without it, the same rope for comparison).
+    sphere: bool,
 }
 
 impl RootedInside {
     fn run(self) -> HeldRun {
-        let RootedInside { joints, segment, depth } = self;
+        let RootedInside { joints, segment, depth, sphere } = self;
         let mut engine = engine_with(EngineSettings::default());
         let (sphere_radius, joint_radius) = (0.085f32, 0.02f32);
         // The chain is given in the anchor's frame, which is at the sphere's centre.
@@ -366,7 +370,9 @@ impl RootedInside {
         let id = engine.create_chain(params, &base).unwrap();
         let def =
             ColliderDef { shape: ColliderShape::Sphere { radius: sphere_radius }, transform: at(HEAD), layers: 1 };
-        engine.create_collider(&def).unwrap();
+        if sphere {
+            engine.create_collider(&def).unwrap();
+        }
         let mut run = HeldRun {
             worst_stretch: 0.0,
             last_stretch: 0.0,
@@ -401,10 +407,13 @@ struct HeldRun {
 }
 
 impl HeldRun {
-    fn assert_within(&self, swinging_stretch: f32) {
+    fn assert_direct_solves(&self) {
+        assert!(self.fallbacks * 20 <= self.substeps, "{} fallbacks", self.fallbacks);
+    }
+
+    fn assert_lengths_and_contacts(&self, swinging_stretch: f32) {
         assert!(self.worst_stretch <= swinging_stretch, "stretch {}", self.worst_stretch);
         assert!(self.last_stretch <= 1e-4, "stretch at the end {}", self.last_stretch);
-        assert!(self.fallbacks * 20 <= self.substeps, "{} fallbacks", self.fallbacks);
         assert!(
             self.worst_free_depth <= 1e-4,
             "a joint that can clear the sphere is {} m inside",

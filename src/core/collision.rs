@@ -7,7 +7,7 @@
 //! point that crossed the surface on the way is put back on the side it came from. So neither a fast chain
 //! nor a fast collider (a swinging arm) skips over the other between substeps.
 
-use glam::{DVec3, Vec3};
+use glam::{DQuat, DVec3, Vec3};
 
 use super::buffers::reserve_total;
 use super::collider::{ColliderShape, ColliderSweep};
@@ -21,6 +21,14 @@ const ROOT_LEVER_MIN: f32 = 0.25;
 /// that straight line a push on the joint barely turns the chain (the lever of `ROOT_LEVER_MIN` again), so the
 /// contact and the lengths would trade the overlap back and forth for every round of every substep.
 const CLEARING_SLANT: f32 = 0.5;
+
+/// A contact next to the joints the root holds turns them about the root only where the normal is at least this
+/// sine away from the lever (the turn is then at most 4 times the push along the arc); otherwise it pushes.
+const MIN_TURN_LEVER: f32 = 0.25;
+/// Largest turn (radians) of the held joints in one contact.
+const MAX_TURN: f64 = 0.5;
+/// Turns at most per contact next to the held joints.
+const TURN_STEPS: usize = 3;
 
 /// What the contact pass needs of a chain besides its positions.
 pub struct ContactInput<'a> {
@@ -43,14 +51,18 @@ pub struct ContactInput<'a> {
 /// current estimate of its end. Particle 0 is kinematic and never moved.
 ///
 /// A joint that was already inside at the start of the substep is pushed out with `start` moving along, so
-/// the push does not become velocity (see also [`pre_stabilise`]).
+/// the push does not become velocity (see also [`pre_stabilise`]). A joint that should slide on a collider in
+/// the lengths solves of the contact rounds (`inextensible::solve_sliding`) gets its world normal in
+/// `normals` (one per particle; the others are left as they are): the first joint past those the root holds
+/// inside a collider (see [`held_by_root`]) once its contact turned them.
 pub fn collide(
     start: &mut [DVec3],
     p: &mut [DVec3],
     input: &ContactInput<'_>,
     bounds: &mut SegmentBounds,
+    normals: &mut [Vec3],
 ) -> ContactPass {
-    collide_at(start, p, input, Pose::End, bounds)
+    collide_at(start, p, input, Pose::End, bounds, Some(normals))
 }
 
 /// Each segment's quick-reject bound for one contact pass, shared by every sphere and capsule the pass
@@ -103,14 +115,14 @@ pub fn pre_stabilise(
     bounds: &mut SegmentBounds,
 ) -> bool {
     scratch.copy_from_slice(x);
-    let mut pass = collide_at(scratch, x, input, Pose::Start, bounds);
+    let mut pass = collide_at(scratch, x, input, Pose::Start, bounds, None);
     // Joints left on a surface by the last substep touch it within rounding: only a real overlap needs rounds.
     if pass.deepest <= settled {
         return false;
     }
     for _ in 1..rounds {
         keep_lengths(scratch, x);
-        pass = collide_at(scratch, x, input, Pose::Start, bounds);
+        pass = collide_at(scratch, x, input, Pose::Start, bounds, None);
         if pass.deepest <= settled {
             break;
         }
@@ -124,6 +136,7 @@ fn collide_at(
     input: &ContactInput<'_>,
     pose: Pose,
     bounds: &mut SegmentBounds,
+    mut normals: Option<&mut [Vec3]>,
 ) -> ContactPass {
     let mut result = ContactPass { tested: 0, touching: false, deepest: 0.0, moved_start: false };
     let outside =
@@ -142,7 +155,7 @@ fn collide_at(
                 collide_inside(start, p, &at(sweep, pose), input, &mut drift)
             }
             ColliderShape::Sphere { .. } | ColliderShape::Capsule { .. } => {
-                collide_outside(start, p, &at(sweep, pose), input, &bounds.bounds, &mut drift)
+                collide_outside(start, p, &at(sweep, pose), input, &bounds.bounds, &mut drift, normals.as_deref_mut())
             }
         };
         result.tested += pass.tested;
@@ -251,6 +264,7 @@ fn collide_outside(
     input: &ContactInput<'_>,
     bounds: &[(DVec3, f64)],
     drift: &mut f64,
+    mut normals: Option<&mut [Vec3]>,
 ) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
@@ -303,6 +317,35 @@ fn collide_outside(
         touching = true;
         deepest = deepest.max(depth);
         let correction = contact.correction(point, before, input.friction);
+        // The segment leaving the joints the root holds: pushing its far end alone would stretch the held run,
+        // which the lengths would undo round after round (bug 9 in docs/robustness.md). The run turns about
+        // the root instead, and its last joint slides on the collider in the contact rounds' lengths solves.
+        let mut world_normal = sweep.end.rotation * normal;
+        let lever = p[k].lerp(p[k + 1], t as f64);
+        if let Some(mut turn) =
+            (k > 0 && k == held.joints).then(|| turn_out(p[0], lever, world_normal, depth)).flatten()
+        {
+            // A turn is right to first order; the surface's curvature leaves a little depth for the next.
+            for _ in 0..TURN_STEPS {
+                *drift += 2.0 * turn_about_root(&mut p[..=k + 1], turn);
+                if overlapping_at_start {
+                    moved_start = true;
+                    *drift += 2.0 * turn_about_root(&mut start[..=k + 1], turn);
+                }
+                let point = p[k].lerp(p[k + 1], t as f64);
+                let Some(left) = contact_outside(before, sweep.end.to_local(point), reach, half_height, input.slop)
+                else {
+                    break;
+                };
+                world_normal = sweep.end.rotation * left.normal;
+                let Some(next) = turn_out(p[0], point, world_normal, left.depth) else { break };
+                turn = next;
+            }
+            if let Some(normals) = normals.as_deref_mut() {
+                normals[k + 1] = world_normal;
+            }
+            continue;
+        }
         // Move the segment's two ends so that the point at `t` moves by `correction` (unit masses; the root's
         // inverse mass is 0).
         let (wa, wb) = (if k == 0 { 0.0 } else { 1.0 - t }, t);
@@ -320,6 +363,33 @@ fn collide_outside(
         }
     }
     ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start }
+}
+
+/// The turn about `root` that moves `point` out along `normal` (unit) by `depth`, to first order: `None` where
+/// the normal points nearly along the lever from the root, so a turn would have to be far larger than the
+/// push (below [`MIN_TURN_LEVER`]) or more than [`MAX_TURN`] radians.
+fn turn_out(root: DVec3, point: DVec3, normal: Vec3, depth: f32) -> Option<DQuat> {
+    // |lever x normal| is the lever's length times the sine between them: a turn by `theta` about that axis
+    // moves the point by `theta` times it along the normal.
+    let axis = (point - root).cross(normal.as_dvec3());
+    let arm = axis.length();
+    if arm <= MIN_TURN_LEVER as f64 * (point - root).length() {
+        return None;
+    }
+    let angle = depth as f64 / arm;
+    (angle <= MAX_TURN).then(|| DQuat::from_axis_angle(axis / arm, angle))
+}
+
+/// Turns `run[1..]` by `turn` about `run[0]`, which keeps the run's lengths. Returns the largest move of a joint.
+fn turn_about_root(run: &mut [DVec3], turn: DQuat) -> f64 {
+    let root = run[0];
+    let mut largest = 0.0f64;
+    for joint in &mut run[1..] {
+        let turned = root + turn * (*joint - root);
+        largest = largest.max((turned - *joint).length());
+        *joint = turned;
+    }
+    largest
 }
 
 /// How many of the chain's first dynamic joints the kinematic root holds on the wrong side of a collider's
@@ -529,6 +599,11 @@ mod tests {
     use super::super::collider::ColliderPose;
     use super::*;
 
+    /// Room for the contact normals of any chain these tests build.
+    fn normals() -> Vec<Vec3> {
+        vec![Vec3::ZERO; 64]
+    }
+
     fn still(shape: ColliderShape) -> ColliderSweep {
         let pose = ColliderPose { centre: DVec3::ZERO, rotation: Quat::IDENTITY };
         ColliderSweep { shape, start: pose, end: pose }
@@ -569,7 +644,7 @@ mod tests {
         let sweep = still(ColliderShape::Sphere { radius: 0.4 });
         let input =
             ContactInput { colliders: &[sweep], radii: &[0.0; 3], lengths: &[0.5, 1.0], friction: 0.0, slop: 0.0 };
-        collide(&mut start, &mut p, &input, &mut SegmentBounds::default());
+        collide(&mut start, &mut p, &input, &mut SegmentBounds::default(), &mut normals());
         let (a, b) = (p[1].as_vec3(), p[2].as_vec3());
         let (t, _) = closest_between_segments((a, b), (Vec3::ZERO, Vec3::ZERO));
         let distance = a.lerp(b, t).length();
@@ -594,10 +669,12 @@ mod tests {
         let input =
             |colliders| ContactInput { colliders, radii: &[0.0; 3], lengths: &[1.0, 0.02], friction: 0.0, slop: 0.0 };
         let (mut start, mut p) = (chain, chain);
-        let together = collide(&mut start, &mut p, &input(&both), &mut SegmentBounds::default());
+        let together = collide(&mut start, &mut p, &input(&both), &mut SegmentBounds::default(), &mut normals());
         let (mut start_apart, mut apart) = (chain, chain);
-        let first = collide(&mut start_apart, &mut apart, &input(&only_a), &mut SegmentBounds::default());
-        let second = collide(&mut start_apart, &mut apart, &input(&only_b), &mut SegmentBounds::default());
+        let first =
+            collide(&mut start_apart, &mut apart, &input(&only_a), &mut SegmentBounds::default(), &mut normals());
+        let second =
+            collide(&mut start_apart, &mut apart, &input(&only_b), &mut SegmentBounds::default(), &mut normals());
         assert!(first.touching && second.touching, "the scene must need both pushes");
         assert_eq!((p, start), (apart, start_apart));
         assert_eq!(together.deepest, first.deepest.max(second.deepest));
@@ -607,20 +684,33 @@ mod tests {
     fn joints_the_root_holds_inside_are_left_and_the_rest_pushed_out() {
         // Root 0.1 inside the reach of a unit sphere (joint radius 0), chain of 0.05 segments along the surface:
         // joints 1 to 3 (0.05 to 0.15 along) could clear it only pointing within 60 degrees of straight out.
+        // They are not pushed one by one: the contact of the segment leaving them turns them, with joint 4,
+        // about the root, so their lengths stay.
         let chain: Vec<DVec3> = (0..6).map(|j| DVec3::new(0.9, -0.05 * j as f64, 0.0)).collect();
         let sphere = still(ColliderShape::Sphere { radius: 1.0 });
         let input =
             ContactInput { colliders: &[sphere], radii: &[0.0; 6], lengths: &[0.05; 5], friction: 0.0, slop: 0.0 };
         let (mut start, mut p) = (chain.clone(), chain.clone());
-        collide(&mut start, &mut p, &input, &mut SegmentBounds::default());
-        assert_eq!(p[..4], chain[..4], "held joints and the root stay");
+        let mut found = normals();
+        collide(&mut start, &mut p, &input, &mut SegmentBounds::default(), &mut found);
+        assert_eq!(p[0], chain[0], "the root stays");
+        for j in 1..=4 {
+            let (from_root, before) = ((p[j] - p[0]).length(), (chain[j] - chain[0]).length());
+            assert!((from_root - before).abs() < 1e-12, "joint {j} turned about the root: {from_root} vs {before}");
+            let segment = (p[j] - p[j - 1]).length();
+            assert!((segment - 0.05).abs() < 1e-12, "segment {} keeps its length: {segment}", j - 1);
+        }
+        assert!(p[1].x > chain[1].x, "the held joints turned outwards: {p:?}");
         assert!(p[4..].iter().all(|q| q.length() >= 1.0 - 1e-6), "{p:?}");
+        // Joint 4 slides on the sphere in the lengths solves of the contact rounds; the others move freely.
+        assert!((found[4].length() - 1.0).abs() < 1e-6, "{found:?}");
+        assert!(found.iter().enumerate().all(|(j, n)| j == 4 || *n == Vec3::ZERO), "{found:?}");
         // The same under the ground: root 0.1 below it, chain lying level.
         let plane = still(ColliderShape::Plane);
         let input = ContactInput { colliders: &[plane], radii: &[0.0; 6], ..input };
         let below: Vec<DVec3> = (0..6).map(|j| DVec3::new(0.05 * j as f64, -0.1, 0.0)).collect();
         let (mut start, mut p) = (below.clone(), below.clone());
-        collide(&mut start, &mut p, &input, &mut SegmentBounds::default());
+        collide(&mut start, &mut p, &input, &mut SegmentBounds::default(), &mut normals());
         assert_eq!(p[..4], below[..4]);
         assert!(p[4..].iter().all(|q| q.y.abs() < 1e-6), "{p:?}");
     }
@@ -636,6 +726,7 @@ mod tests {
             &mut p,
             &ContactInput { colliders: &[plane], radii: &[0.0; 2], lengths: &[1.0], friction: 1.0, slop: 0.0 },
             &mut SegmentBounds::default(),
+            &mut normals(),
         );
         assert!((p[1] - DVec3::new(1.0, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
         // Sliding 0.5: friction removes 0.1 of it.
@@ -645,6 +736,7 @@ mod tests {
             &mut p,
             &ContactInput { colliders: &[plane], radii: &[0.0; 2], lengths: &[1.0], friction: 1.0, slop: 0.0 },
             &mut SegmentBounds::default(),
+            &mut normals(),
         );
         assert!((p[1] - DVec3::new(1.4, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
     }
@@ -690,7 +782,7 @@ mod tests {
             let lengths: Vec<f32> = p.windows(2).map(|w| (w[1] - w[0]).length() as f32).collect();
             let input =
                 |colliders| ContactInput { colliders, radii: &radii, lengths: &lengths, friction: 0.5, slop: 1e-4 };
-            let pass = collide(&mut start, &mut p, &input(&this), &mut SegmentBounds::default());
+            let pass = collide(&mut start, &mut p, &input(&this), &mut SegmentBounds::default(), &mut normals());
             if pass.touching {
                 touched += 1;
                 continue;
@@ -716,6 +808,7 @@ mod tests {
             &mut p,
             &ContactInput { colliders: &[sweep], radii: &[0.1; 2], lengths: &[0.5], friction: 0.0, slop: 0.0 },
             &mut SegmentBounds::default(),
+            &mut normals(),
         );
         assert!((p[1] - DVec3::new(0.9, 0.0, 0.0)).length() < 1e-6, "{}", p[1]);
     }

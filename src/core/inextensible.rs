@@ -4,7 +4,7 @@
 //! O(n) Thomas solve. Where it fails (long or fine chains, bug 1 in docs/robustness.md), [`implicit`] solves
 //! the exact projection instead.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
 use super::buffers::reserve_total;
 use super::implicit::{self, ImplicitScratch};
@@ -119,10 +119,59 @@ fn solve_direct(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> 
     let m = lengths.len();
     debug_assert!(p.len() == m + 1 && s.start_bonds.len() >= m);
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
-    if newton_along_directions(p, &s.start_bonds[..m], l2, inv_l2, &mut s.newton) {
+    if newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton) {
         return Solved::Direct;
     }
     fall_back(p, lengths, s)
+}
+
+/// [`solve_prepared`] for the contact rounds that end a substep: a particle with a contact normal in
+/// `normals` (one per particle; zero for none) slides on its collider's surface, moving only across the
+/// normal, so the lengths stop undoing the contact pass. Where that direct solve fails (the contacts pin
+/// the chain), the lengths are met as [`solve_prepared`] meets them, contacts aside. Returns `false` when
+/// neither direct solve converged.
+pub fn solve_sliding(p: &mut [DVec3], lengths: &[f32], normals: &[Vec3], s: &mut ConstraintScratch) -> bool {
+    let m = lengths.len();
+    debug_assert!(p.len() == m + 1 && normals.len() == m + 1 && s.start_bonds.len() >= m);
+    let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
+    let sliding = Sliding(normals);
+    if newton_along_directions(p, &s.start_bonds[..m], &sliding, l2, inv_l2, &mut s.newton) {
+        return true;
+    }
+    for k in 0..m {
+        s.current_bonds[k] = p[k + 1] - p[k];
+    }
+    if project_relinearized(p, &mut s.current_bonds[..m], &sliding, l2, inv_l2, &mut s.newton) {
+        return false;
+    }
+    solve_prepared(p, lengths, s)
+}
+
+/// Which moves the solve may give each particle (its inverse mass as a projection).
+trait Mobility {
+    /// The part of `v` particle `j` may move along.
+    fn allowed(&self, j: usize, v: DVec3) -> DVec3;
+}
+
+/// Every particle moves freely.
+struct Free;
+
+impl Mobility for Free {
+    #[inline(always)]
+    fn allowed(&self, _: usize, v: DVec3) -> DVec3 {
+        v
+    }
+}
+
+/// A particle with a (unit) contact normal moves only across it; a zero normal leaves it free.
+struct Sliding<'a>(&'a [Vec3]);
+
+impl Mobility for Sliding<'_> {
+    #[inline(always)]
+    fn allowed(&self, j: usize, v: DVec3) -> DVec3 {
+        let normal = self.0[j].as_dvec3();
+        v - normal * normal.dot(v)
+    }
 }
 
 /// What a chain's solves learn for its next substep: where the direct solve fails on a substep's first
@@ -289,7 +338,7 @@ fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> Sol
     for k in 0..m {
         s.current_bonds[k] = p[k + 1] - p[k];
     }
-    if project_relinearized(p, &mut s.current_bonds[..m], l2, inv_l2, &mut s.newton) {
+    if project_relinearized(p, &mut s.current_bonds[..m], &Free, l2, inv_l2, &mut s.newton) {
         return Solved::GaussNewton;
     }
     if implicit::project(p, l2, inv_l2, TOLERANCE, &mut s.implicit) {
@@ -307,6 +356,7 @@ fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> Sol
 fn project_relinearized(
     p: &mut [DVec3],
     d: &mut [DVec3],
+    mobility: &impl Mobility,
     length_squared: &[f64],
     inverse_length_squared: &[f64],
     s: &mut NewtonScratch,
@@ -323,7 +373,7 @@ fn project_relinearized(
         }
         let mut pass = ForwardPass::default();
         for k in 0..m {
-            pass.row(k, d[k], d, l2[k], inv_l2[k], c_prime, d_prime);
+            pass.row(k, d[k], d, mobility, l2[k], inv_l2[k], c_prime, d_prime);
         }
         if pass.converged(previous_worst) {
             return true;
@@ -338,7 +388,7 @@ fn project_relinearized(
             return false;
         }
         for j in 1..=m {
-            p[j] += shift(d, mu, j);
+            p[j] += shift(d, mobility, mu, j);
         }
     }
     false
@@ -356,6 +406,7 @@ fn project_relinearized(
 fn newton_along_directions(
     p: &mut [DVec3],
     d: &[DVec3],
+    mobility: &impl Mobility,
     length_squared: &[f64],
     inverse_length_squared: &[f64],
     s: &mut NewtonScratch,
@@ -371,13 +422,13 @@ fn newton_along_directions(
         if iteration == 0 {
             // No corrections yet: the bonds of `p`.
             for k in 0..m {
-                pass.row(k, p[k + 1] - p[k], d, l2[k], inv_l2[k], c_prime, d_prime);
+                pass.row(k, p[k + 1] - p[k], d, mobility, l2[k], inv_l2[k], c_prime, d_prime);
             }
         } else {
             corrected[0] = p[0];
             for k in 0..m {
-                corrected[k + 1] = p[k + 1] + shift(d, mu, k + 1);
-                pass.row(k, corrected[k + 1] - corrected[k], d, l2[k], inv_l2[k], c_prime, d_prime);
+                corrected[k + 1] = p[k + 1] + shift(d, mobility, mu, k + 1);
+                pass.row(k, corrected[k + 1] - corrected[k], d, mobility, l2[k], inv_l2[k], c_prime, d_prime);
             }
         }
         if pass.converged(previous_worst) {
@@ -402,10 +453,10 @@ fn newton_along_directions(
         if !back_substitute(c_prime, d_prime, mu, step, update) {
             return false;
         }
-        if pass.worst <= LANDING_GATE && error_after_step(d, step, inv_l2) <= TOLERANCE {
+        if pass.worst <= LANDING_GATE && error_after_step(d, mobility, step, inv_l2) <= TOLERANCE {
             // The pass that would confirm it computes these same positions.
             for j in 1..=m {
-                p[j] += shift(d, mu, j);
+                p[j] += shift(d, mobility, mu, j);
             }
             return true;
         }
@@ -423,12 +474,12 @@ pub(crate) const LANDING_GATE: f64 = 1e-3;
 /// so what remains is `|Δb_k|^2`, the square of the bond's change. This is what the next pass would measure
 /// (up to its rounding), without the pass's elimination.
 #[inline]
-fn error_after_step(d: &[DVec3], step: &[f64], inv_l2: &[f64]) -> f64 {
+fn error_after_step(d: &[DVec3], mobility: &impl Mobility, step: &[f64], inv_l2: &[f64]) -> f64 {
     let m = d.len();
     let mut worst = 0.0f64;
     let mut below = DVec3::ZERO;
     for k in 0..m {
-        let above = shift(d, step, k + 1);
+        let above = shift(d, mobility, step, k + 1);
         let error = (above - below).length_squared() * inv_l2[k];
         if error > worst {
             worst = error;
@@ -466,9 +517,9 @@ fn back_substitute(c_prime: &[f64], d_prime: &[f64], mu: &mut [f64], step: &mut 
 
 /// How far the multipliers `mu` along the directions `d` move particle `j >= 1`.
 #[inline(always)]
-fn shift(d: &[DVec3], mu: &[f64], j: usize) -> DVec3 {
+fn shift(d: &[DVec3], mobility: &impl Mobility, mu: &[f64], j: usize) -> DVec3 {
     let pulled = d[j - 1] * mu[j - 1];
-    if j < d.len() { pulled - d[j] * mu[j] } else { pulled }
+    mobility.allowed(j, if j < d.len() { pulled - d[j] * mu[j] } else { pulled })
 }
 
 /// The running state of one root-to-tip pass of [`newton_along_directions`].
@@ -492,7 +543,17 @@ impl ForwardPass {
     /// Bond `k` with vector `b`: its error, and its row of the forward elimination (one division).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn row(&mut self, k: usize, b: DVec3, d: &[DVec3], l2: f64, inv_l2: f64, c_prime: &mut [f64], d_prime: &mut [f64]) {
+    fn row(
+        &mut self,
+        k: usize,
+        b: DVec3,
+        d: &[DVec3],
+        mobility: &impl Mobility,
+        l2: f64,
+        inv_l2: f64,
+        c_prime: &mut [f64],
+        d_prime: &mut [f64],
+    ) {
         let m = d.len();
         let f = b.length_squared() - l2;
         let error = (f * inv_l2).abs();
@@ -500,10 +561,13 @@ impl ForwardPass {
         if error > self.worst {
             self.worst = error;
         }
+        // The bond as each of its ends may change it (the mobility is a projection: `b . W d = W b . d`). For
+        // free particles both are `b`, and the diagonal is `2 b . d[k]` to the bit.
+        let (at_start, at_end) = (mobility.allowed(k, b), mobility.allowed(k + 1, b));
         // The root's end of bond 0 does not move, so bond 0's own correction counts once.
-        let diagonal = if k > 0 { 2.0 * b.dot(d[k]) } else { b.dot(d[k]) };
-        let lower = if k > 0 { -b.dot(d[k - 1]) } else { 0.0 };
-        let upper = if k + 1 < m { -b.dot(d[k + 1]) } else { 0.0 };
+        let diagonal = if k > 0 { at_end.dot(d[k]) + at_start.dot(d[k]) } else { at_end.dot(d[k]) };
+        let lower = if k > 0 { -at_start.dot(d[k - 1]) } else { 0.0 };
+        let upper = if k + 1 < m { -at_end.dot(d[k + 1]) } else { 0.0 };
         let den = diagonal - lower * self.c_last;
         if diagonal.abs() > self.scale {
             self.scale = diagonal.abs();
@@ -609,11 +673,11 @@ mod tests {
         let (d, l2, inv_l2) =
             (s.start_bonds[..m].to_vec(), s.length_squared[..m].to_vec(), s.inverse_length_squared[..m].to_vec());
         let mut stepped = p.clone();
-        assert!(newton_along_directions(&mut stepped, &d, &l2, &inv_l2, &mut s.newton));
+        assert!(newton_along_directions(&mut stepped, &d, &Free, &l2, &inv_l2, &mut s.newton));
         let measured = (0..m)
             .map(|k| (((stepped[k + 1] - stepped[k]).length_squared() - l2[k]) * inv_l2[k]).abs())
             .fold(0.0, f64::max);
-        let predicted = error_after_step(&d, &s.newton.step[..m], &inv_l2);
+        let predicted = error_after_step(&d, &Free, &s.newton.step[..m], &inv_l2);
         assert!(measured <= TOLERANCE, "{measured}");
         assert!((measured - predicted).abs() <= 1e-14, "{measured} vs {predicted}");
         assert!(predicted > 0.0);
@@ -666,7 +730,7 @@ mod tests {
         let mut relinearized = predicted.clone();
         s.current_bonds[..m].copy_from_slice(&predicted.windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>());
         let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
-        assert!(!project_relinearized(&mut relinearized, &mut s.current_bonds[..m], l2, inv_l2, &mut s.newton));
+        assert!(!project_relinearized(&mut relinearized, &mut s.current_bonds[..m], &Free, l2, inv_l2, &mut s.newton));
 
         let mut projected = predicted.clone();
         s.implicit.begin(&projected, &multipliers);

@@ -157,6 +157,8 @@ pub struct RodScratch {
     p_old: Vec<DVec3>,
     constraints: ConstraintScratch,
     bounds: SegmentBounds,
+    /// The contact normal of each particle that the last iteration's contact passes moved (zero for none).
+    normals: Vec<Vec3>,
 }
 
 impl RodScratch {
@@ -166,6 +168,7 @@ impl RodScratch {
             self.p.resize(n, DVec3::ZERO);
             self.qp.resize(n, Quat::IDENTITY);
             self.p_old.resize(n, DVec3::ZERO);
+            self.normals.resize(n, Vec3::ZERO);
         }
         self.constraints.reserve(n.saturating_sub(1));
         self.bounds.reserve(n.saturating_sub(1));
@@ -182,7 +185,7 @@ pub fn substep(
     let n = state.x.len();
     scratch.reserve(n);
     let h = input.h;
-    let RodScratch { p, qp, p_old, constraints, bounds } = scratch;
+    let RodScratch { p, qp, p_old, constraints, bounds, normals } = scratch;
     let settled = input.contact_settled;
     if let Some(contacts) = &input.contacts {
         let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
@@ -240,7 +243,9 @@ pub fn substep(
         };
         report.fallback |= !solved;
         if let Some(contacts) = &input.contacts {
-            let mut pass = collide(&mut state.x, p, contacts, bounds);
+            let normals = &mut normals[..n];
+            normals.fill(Vec3::ZERO);
+            let mut pass = collide(&mut state.x, p, contacts, bounds, normals);
             inextensible::prepare(&state.x, lengths, constraints);
             report.contact_pairs += pass.tested;
             // A collider pushing hard (a swinging arm) moves a few particles far in one substep; the rest of
@@ -250,8 +255,10 @@ pub fn substep(
                     if !pass.touching || pass.deepest <= settled {
                         break;
                     }
-                    report.fallback |= !inextensible::solve_prepared(p, lengths, constraints);
-                    pass = collide(&mut state.x, p, contacts, bounds);
+                    // Joints the contacts gave a normal slide on their colliders here, so the lengths do not
+                    // undo those contacts round after round (bug 9 in docs/robustness.md).
+                    report.fallback |= !inextensible::solve_sliding(p, lengths, normals, constraints);
+                    pass = collide(&mut state.x, p, contacts, bounds, normals);
                     inextensible::prepare(&state.x, lengths, constraints);
                     report.contact_pairs += pass.tested;
                 }

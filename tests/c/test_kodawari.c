@@ -1651,7 +1651,10 @@ static int test_chain_stays_outside_sphere_collider(void)
         ENSURE_OK(kdw_engine_step(e, FRAME_DT, &camera, &anchor));
     }
     ENSURE(closest_joint(e, chain, centre, &closest) == 0);
-    ENSURE(closest >= BALL_RADIUS + 0.02 - 1e-3 && closest < BALL_RADIUS + 0.02 + 5e-3);
+    if (!(closest >= BALL_RADIUS + 0.02 - 1e-3 && closest < BALL_RADIUS + 0.02 + 5e-3)) {
+        printf("    with the def's radius the closest joint is %.6f m from the ball's centre\n", closest);
+        return 1;
+    }
     return 0;
 }
 

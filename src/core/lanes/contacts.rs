@@ -3,7 +3,7 @@
 //! different for every chain, so they stay scalar; what the lanes gain is the rest of the substep (shape
 //! matching and the lengths), which a chain near a collider would otherwise run on the scalar solver.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
 use super::group::LaneGroup;
 use super::simd::{DV3, Mask};
@@ -33,12 +33,15 @@ pub(crate) struct LaneContacts {
     pub pass: Option<ContactPass>,
     /// `SubstepInput::starts_clear`: the substep before, in the same step, ended on a pass that touched nothing.
     pub starts_clear: bool,
+    /// The contact normal of each particle that the last iteration's contact passes moved (zero for none).
+    pub normals: Vec<Vec3>,
 }
 
 impl LaneContacts {
     /// Room for a chain of `joints` joints that may touch `colliders` colliders.
     pub(super) fn reserve(&mut self, joints: usize, colliders: usize) {
         reserve_total(&mut self.radii, joints);
+        reserve_total(&mut self.normals, joints);
         reserve_total(&mut self.lengths, joints.saturating_sub(1));
         reserve_total(&mut self.candidates, colliders);
         reserve_total(&mut self.sweeps, colliders);
@@ -105,8 +108,9 @@ pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) {
 }
 
 /// One contact pass (`collision::collide`) on the lanes in `lanes`, moving their positions and, where a joint
-/// was inside already at the start of the substep, their start positions. Returns the pairs tested.
-pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> u64 {
+/// was inside already at the start of the substep, their start positions. An iteration's pass (`fresh`)
+/// forgets the contact normals of the passes before; a contact round's adds to them. Returns the pairs tested.
+pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, fresh: bool) -> u64 {
     let n = g.n;
     let mut tested = 0;
     for lane in (0..L).filter(|&lane| lanes.0[lane]) {
@@ -114,7 +118,18 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> u64 {
         extract(&x[..n], lane, lane_x);
         extract(&p[..n], lane, lane_p);
         let contact = &mut contacts[lane];
-        let pass = collision::collide(lane_x, lane_p, &contact.input(), segment_bounds);
+        if fresh {
+            contact.normals.clear();
+            contact.normals.resize(n, Vec3::ZERO);
+        }
+        let input = ContactInput {
+            colliders: &contact.sweeps,
+            radii: &contact.radii,
+            lengths: &contact.lengths,
+            friction: contact.friction,
+            slop: contact.slop,
+        };
+        let pass = collision::collide(lane_x, lane_p, &input, segment_bounds, &mut contact.normals);
         contact.pass = Some(pass);
         tested += pass.tested;
         // Only a contact moves positions, and only a joint inside since the start moves start positions.
@@ -126,6 +141,24 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> u64 {
         }
     }
     tested
+}
+
+/// The lengths solve of a contact round (`inextensible::solve_sliding`) on the lanes of `lanes`, one lane at a
+/// time, as the scalar solver runs it. Returns the lanes where no direct solve converged (the fallback ran).
+pub fn solve_sliding<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> Mask<L> {
+    let n = g.n;
+    let mut fell_back = Mask([false; L]);
+    for lane in (0..L).filter(|&lane| lanes.0[lane]) {
+        let LaneGroup { x, p, lengths, lane_x, lane_p, lane_lengths, contacts, constraints, .. } = g;
+        extract(&x[..n], lane, lane_x);
+        extract(&p[..n], lane, lane_p);
+        lane_lengths.clear();
+        lane_lengths.extend(lengths[..n - 1].iter().map(|l| l.0[lane]));
+        inextensible::prepare(lane_x, lane_lengths, constraints);
+        fell_back.0[lane] = !inextensible::solve_sliding(lane_p, lane_lengths, &contacts[lane].normals, constraints);
+        write_back(lane_p, lane, &mut p[..n]);
+    }
+    fell_back
 }
 
 /// The lanes of `lanes` whose last contact pass corrected something by more than their settled distance:

@@ -65,7 +65,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
     let mut pairs = 0;
     for iteration in 0..iterations {
         fell_back = fell_back.or(iterate(g, phases, iteration == 0));
-        pairs += contacts::collide(g, touching);
+        pairs += contacts::collide(g, touching, true);
         start_bonds(g);
         if iteration + 1 == iterations {
             for _ in 1..FINAL_CONTACT_ROUNDS {
@@ -73,13 +73,8 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
                 if !again.any() {
                     break;
                 }
-                let solved = (phases.solve_lengths)(g, again);
-                let failed = again.and(solved.not());
-                if failed.any() {
-                    fell_back = fell_back.or(failed);
-                    fall_back(g, failed, false);
-                }
-                pairs += contacts::collide(g, again);
+                fell_back = fell_back.or(contacts::solve_sliding(g, again));
+                pairs += contacts::collide(g, again, false);
                 start_bonds(g);
             }
         }

@@ -138,7 +138,7 @@ fn collide_at(
     bounds: &mut SegmentBounds,
     mut normals: Option<&mut [Vec3]>,
 ) -> ContactPass {
-    let mut result = ContactPass { tested: 0, touching: false, deepest: 0.0, moved_start: false };
+    let mut result = ContactPass { tested: 0, touching: false, deepest: 0.0, moved_start: false, sliding: false };
     let outside =
         |sweep: &ColliderSweep| matches!(sweep.shape, ColliderShape::Sphere { .. } | ColliderShape::Capsule { .. });
     if input.colliders.iter().any(outside) {
@@ -162,6 +162,7 @@ fn collide_at(
         result.touching |= pass.touching;
         result.deepest = result.deepest.max(pass.deepest);
         result.moved_start |= pass.moved_start;
+        result.sliding |= pass.sliding;
     }
     result
 }
@@ -184,6 +185,8 @@ pub struct ContactPass {
     pub deepest: f32,
     /// Some start position was moved too (a joint inside since the start of the substep).
     pub moved_start: bool,
+    /// Some joint got a normal to slide along (see [`collide`]).
+    pub sliding: bool,
 }
 
 fn collide_plane(
@@ -217,7 +220,7 @@ fn collide_plane(
             *drift += contact.push_particle(start, p, sweep, local, moved, input.friction);
         }
     }
-    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start }
+    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start, sliding: false }
 }
 
 fn collide_inside(
@@ -254,7 +257,7 @@ fn collide_inside(
             *drift += contact.push_particle(&mut start[j], &mut p[j], sweep, local, moved, input.friction);
         }
     }
-    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start }
+    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start, sliding: false }
 }
 
 fn collide_outside(
@@ -264,11 +267,12 @@ fn collide_outside(
     input: &ContactInput<'_>,
     bounds: &[(DVec3, f64)],
     drift: &mut f64,
-    mut normals: Option<&mut [Vec3]>,
+    normals: Option<&mut [Vec3]>,
 ) -> ContactPass {
     let mut touching = false;
     let mut deepest = 0.0f32;
     let mut moved_start = false;
+    let mut sliding = false;
     let (radius, half_height) = sweep.shape.capsule().expect("outside colliders are spheres or capsules");
     let axis = (Vec3::new(0.0, -half_height, 0.0), Vec3::new(0.0, half_height, 0.0));
     // Quick reject, in world space and conservative: a segment whose every point stays farther from the
@@ -286,66 +290,41 @@ fn collide_outside(
     } else {
         (Held::NONE, f32::INFINITY)
     };
+    let collider = OutsideCollider { centre, collider_travel, solid, radius, half_height, axis, held, root_distance };
     // Segments before `held` join joints the root holds inside (or the root itself): nothing to test.
-    for (i, &(midpoint, segment_reach)) in bounds[held.joints..].iter().enumerate() {
-        let k = held.joints + i;
-        let clear = solid + segment_reach + collider_travel + 3.0 * *drift;
-        if (midpoint - centre).length_squared() > clear * clear {
-            continue;
+    let mut first = held.joints;
+    // The segment leaving the joints the root holds: pushing its far end alone would stretch the held run, which
+    // the lengths would undo round after round (bug 9 in docs/robustness.md). The run turns about the root
+    // instead, and its last joint slides on the collider in the contact rounds' lengths solves. Where it cannot
+    // turn, the loop below pushes the segment like any other. (Outside the loop: inside, its code made the loop
+    // slower for every chain.)
+    // (When the root holds every joint, there is no such segment.)
+    if held.joints > 0 && held.joints < bounds.len() {
+        let k = held.joints;
+        let found = segment_contact(k, bounds[k], start, p, sweep, input, &collider, *drift);
+        if let Some(turned) = found.and_then(|found| turn_held_run(start, p, k, &found, sweep, input.slop)) {
+            touching = true;
+            deepest = deepest.max(turned.depth);
+            *drift += turned.drift;
+            moved_start |= turned.moved_start;
+            if let Some(normals) = normals {
+                normals[k + 1] = turned.normal;
+                sliding = true;
+            }
+            first += 1;
         }
-        let (a, b) = (sweep.end.to_local(p[k]), sweep.end.to_local(p[k + 1]));
-        let (mut t, _) = closest_between_segments((a, b), axis);
-        // The root is kinematic: a contact next to it could only be met by a large turn of the segment.
-        if k == 0 && t < ROOT_LEVER_MIN {
-            t = 1.0;
-        }
-        let reach_at = |t: f32| radius + input.radii[k] + (input.radii[k + 1] - input.radii[k]) * t;
-        // The segment from the last joint the root holds inside: its points near that joint are held too.
-        if k > 0
-            && k == held.joints
-            && root_distance + (held.along + t * input.lengths[k]) * CLEARING_SLANT < reach_at(t)
-        {
-            t = 1.0;
-        }
-        let point = a.lerp(b, t);
-        let reach = reach_at(t);
-        let before = sweep.start.to_local(start[k].lerp(start[k + 1], t as f64));
-        let Some(contact) = contact_outside(before, point, reach, half_height, input.slop) else {
+    }
+    for (i, &bound) in bounds[first..].iter().enumerate() {
+        let k = first + i;
+        let Some(SegmentContact { t, point, before, contact, .. }) =
+            segment_contact(k, bound, start, p, sweep, input, &collider, *drift)
+        else {
             continue;
         };
         let Contact { normal, depth, overlapping_at_start } = contact;
         touching = true;
         deepest = deepest.max(depth);
         let correction = contact.correction(point, before, input.friction);
-        // The segment leaving the joints the root holds: pushing its far end alone would stretch the held run,
-        // which the lengths would undo round after round (bug 9 in docs/robustness.md). The run turns about
-        // the root instead, and its last joint slides on the collider in the contact rounds' lengths solves.
-        let mut world_normal = sweep.end.rotation * normal;
-        let lever = p[k].lerp(p[k + 1], t as f64);
-        if let Some(mut turn) =
-            (k > 0 && k == held.joints).then(|| turn_out(p[0], lever, world_normal, depth)).flatten()
-        {
-            // A turn is right to first order; the surface's curvature leaves a little depth for the next.
-            for _ in 0..TURN_STEPS {
-                *drift += 2.0 * turn_about_root(&mut p[..=k + 1], turn);
-                if overlapping_at_start {
-                    moved_start = true;
-                    *drift += 2.0 * turn_about_root(&mut start[..=k + 1], turn);
-                }
-                let point = p[k].lerp(p[k + 1], t as f64);
-                let Some(left) = contact_outside(before, sweep.end.to_local(point), reach, half_height, input.slop)
-                else {
-                    break;
-                };
-                world_normal = sweep.end.rotation * left.normal;
-                let Some(next) = turn_out(p[0], point, world_normal, left.depth) else { break };
-                turn = next;
-            }
-            if let Some(normals) = normals.as_deref_mut() {
-                normals[k + 1] = world_normal;
-            }
-            continue;
-        }
         // Move the segment's two ends so that the point at `t` moves by `correction` (unit masses; the root's
         // inverse mass is 0).
         let (wa, wb) = (if k == 0 { 0.0 } else { 1.0 - t }, t);
@@ -362,7 +341,69 @@ fn collide_outside(
             *drift += push.length() * (wa + wb) as f64;
         }
     }
-    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start }
+    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start, sliding }
+}
+
+/// An outside collider as [`segment_contact`] tests segments against it.
+struct OutsideCollider {
+    centre: DVec3,
+    collider_travel: f64,
+    /// Its radius plus half height: how far its surface reaches from its centre.
+    solid: f64,
+    radius: f32,
+    half_height: f32,
+    /// Its axis segment, in its own frame.
+    axis: (Vec3, Vec3),
+    held: Held,
+    /// The root's distance from the axis (infinite when the root holds nothing).
+    root_distance: f32,
+}
+
+/// Where a segment meets an outside collider: at `t` along it, the material point now at `point` and at
+/// `before` at the start of the substep (both in the collider's frame), whose reach there is `reach`.
+struct SegmentContact {
+    t: f32,
+    point: Vec3,
+    before: Vec3,
+    reach: f32,
+    contact: Contact,
+}
+
+/// The contact of segment `k` (its quick-reject bound `bound`) with `collider`, if any. `drift` is how far the
+/// pass has moved things since the bounds were computed.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn segment_contact(
+    k: usize,
+    (midpoint, segment_reach): (DVec3, f64),
+    start: &[DVec3],
+    p: &[DVec3],
+    sweep: &ColliderSweep,
+    input: &ContactInput<'_>,
+    collider: &OutsideCollider,
+    drift: f64,
+) -> Option<SegmentContact> {
+    let OutsideCollider { centre, collider_travel, solid, radius, half_height, axis, held, root_distance } = *collider;
+    let clear = solid + segment_reach + collider_travel + 3.0 * drift;
+    if (midpoint - centre).length_squared() > clear * clear {
+        return None;
+    }
+    let (a, b) = (sweep.end.to_local(p[k]), sweep.end.to_local(p[k + 1]));
+    let (mut t, _) = closest_between_segments((a, b), axis);
+    // The root is kinematic: a contact next to it could only be met by a large turn of the segment.
+    if k == 0 && t < ROOT_LEVER_MIN {
+        t = 1.0;
+    }
+    let reach_at = |t: f32| radius + input.radii[k] + (input.radii[k + 1] - input.radii[k]) * t;
+    // The segment from the last joint the root holds inside: its points near that joint are held too.
+    if k > 0 && k == held.joints && root_distance + (held.along + t * input.lengths[k]) * CLEARING_SLANT < reach_at(t) {
+        t = 1.0;
+    }
+    let point = a.lerp(b, t);
+    let reach = reach_at(t);
+    let before = sweep.start.to_local(start[k].lerp(start[k + 1], t as f64));
+    let contact = contact_outside(before, point, reach, half_height, input.slop)?;
+    Some(SegmentContact { t, point, before, reach, contact })
 }
 
 /// The turn about `root` that moves `point` out along `normal` (unit) by `depth`, to first order: `None` where
@@ -378,6 +419,49 @@ fn turn_out(root: DVec3, point: DVec3, normal: Vec3, depth: f32) -> Option<DQuat
     }
     let angle = depth as f64 / arm;
     (angle <= MAX_TURN).then(|| DQuat::from_axis_angle(axis / arm, angle))
+}
+
+/// What [`turn_held_run`] did: the depth of the contact it met, how far it moved joints (for the quick
+/// reject's drift), whether it moved start positions, and the contact normal where the turned joint ended.
+struct Turned {
+    depth: f32,
+    drift: f64,
+    moved_start: bool,
+    normal: Vec3,
+}
+
+/// Turns the held joints and the joint `k + 1` past them about the root until the contact point of segment `k`
+/// (`found`) is out, up to [`TURN_STEPS`] turns (a turn is right to first order; the surface's curvature
+/// leaves a little depth). Start positions turn along when the contact overlapped at the start
+/// (pre-stabilisation). `None` (nothing moved) where a turn cannot push the point out (see [`turn_out`]).
+#[cold]
+#[inline(never)]
+fn turn_held_run(
+    start: &mut [DVec3],
+    p: &mut [DVec3],
+    k: usize,
+    found: &SegmentContact,
+    sweep: &ColliderSweep,
+    slop: f32,
+) -> Option<Turned> {
+    let SegmentContact { t, before, reach, ref contact, .. } = *found;
+    let half_height = sweep.shape.capsule().map_or(0.0, |(_, half_height)| half_height);
+    let normal = sweep.end.rotation * contact.normal;
+    let mut turn = turn_out(p[0], p[k].lerp(p[k + 1], t as f64), normal, contact.depth)?;
+    let mut turned = Turned { depth: contact.depth, drift: 0.0, moved_start: false, normal };
+    for _ in 0..TURN_STEPS {
+        turned.drift += 2.0 * turn_about_root(&mut p[..=k + 1], turn);
+        if contact.overlapping_at_start {
+            turned.moved_start = true;
+            turned.drift += 2.0 * turn_about_root(&mut start[..=k + 1], turn);
+        }
+        let point = p[k].lerp(p[k + 1], t as f64);
+        let Some(left) = contact_outside(before, sweep.end.to_local(point), reach, half_height, slop) else { break };
+        turned.normal = sweep.end.rotation * left.normal;
+        let Some(next) = turn_out(p[0], point, turned.normal, left.depth) else { break };
+        turn = next;
+    }
+    Some(turned)
 }
 
 /// Turns `run[1..]` by `turn` about `run[0]`, which keeps the run's lengths. Returns the largest move of a joint.
@@ -435,6 +519,7 @@ fn distance_from_axis(q: Vec3, half_height: f32) -> f32 {
 /// A point still on the side of the axis it came from is pushed out the shortest way. A point that came
 /// from outside and is now past the axis went through: it is put back on the tangent plane where its path
 /// entered, so it ends on the side it came from whatever the step size.
+#[inline(always)]
 fn contact_outside(before: Vec3, now: Vec3, reach: f32, half_height: f32, slop: f32) -> Option<Contact> {
     let axis_point = |q: Vec3| Vec3::new(0.0, q.y.clamp(-half_height, half_height), 0.0);
     let (from_axis_before, from_axis_now) = (before - axis_point(before), now - axis_point(now));
@@ -456,6 +541,7 @@ fn contact_outside(before: Vec3, now: Vec3, reach: f32, half_height: f32, slop: 
 }
 
 /// A contact to resolve: push the point `depth` along `normal`.
+#[derive(Clone, Copy)]
 struct Contact {
     normal: Vec3,
     depth: f32,
@@ -713,6 +799,19 @@ mod tests {
         collide(&mut start, &mut p, &input, &mut SegmentBounds::default(), &mut normals());
         assert_eq!(p[..4], below[..4]);
         assert!(p[4..].iter().all(|q| q.y.abs() < 1e-6), "{p:?}");
+    }
+
+    #[test]
+    fn a_chain_the_root_holds_whole_is_left_alone() {
+        // Root 0.5 inside a unit sphere's reach, three 0.05 segments: every joint is held, none is tested.
+        let chain: Vec<DVec3> = (0..4).map(|j| DVec3::new(0.5, -0.05 * j as f64, 0.0)).collect();
+        let sphere = still(ColliderShape::Sphere { radius: 1.0 });
+        let input =
+            ContactInput { colliders: &[sphere], radii: &[0.0; 4], lengths: &[0.05; 3], friction: 0.0, slop: 0.0 };
+        let (mut start, mut p) = (chain.clone(), chain.clone());
+        let pass = collide(&mut start, &mut p, &input, &mut SegmentBounds::default(), &mut normals());
+        assert!(!pass.touching && !pass.sliding);
+        assert_eq!(p, chain);
     }
 
     #[test]

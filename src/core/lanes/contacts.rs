@@ -33,8 +33,11 @@ pub(crate) struct LaneContacts {
     pub pass: Option<ContactPass>,
     /// `SubstepInput::starts_clear`: the substep before, in the same step, ended on a pass that touched nothing.
     pub starts_clear: bool,
-    /// The contact normal of each particle that the last iteration's contact passes moved (zero for none).
+    /// The contact normal of each particle that slides on a collider in the contact rounds' lengths solves
+    /// (`collision::collide`; zero for none), since the last iteration's contact pass.
     pub normals: Vec<Vec3>,
+    /// Some particle has a normal in `normals`.
+    pub sliding: bool,
 }
 
 impl LaneContacts {
@@ -118,9 +121,11 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, fresh: bool
         extract(&x[..n], lane, lane_x);
         extract(&p[..n], lane, lane_p);
         let contact = &mut contacts[lane];
-        if fresh {
+        // All zero already unless some joint slid.
+        if fresh && (contact.sliding || contact.normals.len() != n) {
             contact.normals.clear();
             contact.normals.resize(n, Vec3::ZERO);
+            contact.sliding = false;
         }
         let input = ContactInput {
             colliders: &contact.sweeps,
@@ -130,6 +135,7 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, fresh: bool
             slop: contact.slop,
         };
         let pass = collision::collide(lane_x, lane_p, &input, segment_bounds, &mut contact.normals);
+        contact.sliding |= pass.sliding;
         contact.pass = Some(pass);
         tested += pass.tested;
         // Only a contact moves positions, and only a joint inside since the start moves start positions.
@@ -141,6 +147,15 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, fresh: bool
         }
     }
     tested
+}
+
+/// The lanes of `lanes` with a particle that slides on a collider in the contact rounds.
+pub fn sliding<const L: usize>(g: &LaneGroup<L>, lanes: Mask<L>) -> Mask<L> {
+    let mut out = Mask([false; L]);
+    for lane in (0..L).filter(|&lane| lanes.0[lane]) {
+        out.0[lane] = g.contacts[lane].sliding;
+    }
+    out
 }
 
 /// The lengths solve of a contact round (`inextensible::solve_sliding`) on the lanes of `lanes`, one lane at a

@@ -73,7 +73,21 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
                 if !again.any() {
                     break;
                 }
-                fell_back = fell_back.or(contacts::solve_sliding(g, again));
+                // Lanes with a joint that slides on a collider take the scalar solve that lets it; with none
+                // sliding that solve is the vector one's, to the bit.
+                let sliding = contacts::sliding(g, again);
+                let vector = again.and(sliding.not());
+                if vector.any() {
+                    let solved = (phases.solve_lengths)(g, vector);
+                    let failed = vector.and(solved.not());
+                    if failed.any() {
+                        fell_back = fell_back.or(failed);
+                        fall_back(g, failed, false);
+                    }
+                }
+                if sliding.any() {
+                    fell_back = fell_back.or(contacts::solve_sliding(g, sliding));
+                }
                 pairs += contacts::collide(g, again, false);
                 start_bonds(g);
             }

@@ -25,7 +25,7 @@ const CLEARING_SLANT: f32 = 0.5;
 /// A contact next to the joints the root holds turns them about the root only where the normal is at least this
 /// sine away from the lever (the turn is then at most 4 times the push along the arc); otherwise it pushes.
 const MIN_TURN_LEVER: f32 = 0.25;
-/// Largest turn (radians) of the held joints in one contact.
+/// Largest turn (radians) of the held joints in one step of [`turn_held_run`].
 const MAX_TURN: f64 = 0.5;
 /// Turns at most per contact next to the held joints.
 const TURN_STEPS: usize = 3;
@@ -291,14 +291,12 @@ fn collide_outside(
         (Held::NONE, f32::INFINITY)
     };
     let collider = OutsideCollider { centre, collider_travel, solid, radius, half_height, axis, held, root_distance };
-    // Segments before `held` join joints the root holds inside (or the root itself): nothing to test.
-    let mut first = held.joints;
     // The segment leaving the joints the root holds: pushing its far end alone would stretch the held run, which
     // the lengths would undo round after round (bug 9 in docs/robustness.md). The run turns about the root
-    // instead, and its last joint slides on the collider in the contact rounds' lengths solves. Where it cannot
-    // turn, the loop below pushes the segment like any other. (Outside the loop: inside, its code made the loop
-    // slower for every chain.)
-    // (When the root holds every joint, there is no such segment.)
+    // instead, and its last joint slides on the collider in the contact rounds' lengths solves. The loop below
+    // then tests the segment like any other: it pushes what depth the turns left, or all of it where the run
+    // cannot turn. (Outside the loop: inside, its code made the loop slower for every chain. When the root holds
+    // every joint, there is no such segment.)
     if held.joints > 0 && held.joints < bounds.len() {
         let k = held.joints;
         let found = segment_contact(k, bounds[k], start, p, sweep, input, &collider, *drift);
@@ -311,11 +309,11 @@ fn collide_outside(
                 normals[k + 1] = turned.normal;
                 sliding = true;
             }
-            first += 1;
         }
     }
-    for (i, &bound) in bounds[first..].iter().enumerate() {
-        let k = first + i;
+    // Segments before `held` join joints the root holds inside (or the root itself): nothing to test.
+    for (i, &bound) in bounds[held.joints..].iter().enumerate() {
+        let k = held.joints + i;
         let Some(SegmentContact { t, point, before, contact, .. }) =
             segment_contact(k, bound, start, p, sweep, input, &collider, *drift)
         else {
@@ -422,7 +420,7 @@ fn turn_out(root: DVec3, point: DVec3, normal: Vec3, depth: f32) -> Option<DQuat
 }
 
 /// What [`turn_held_run`] did: the depth of the contact it met, how far it moved joints (for the quick
-/// reject's drift), whether it moved start positions, and the contact normal where the turned joint ended.
+/// reject's drift), whether it moved start positions, and the contact normal of its last turn.
 struct Turned {
     depth: f32,
     drift: f64,
@@ -444,7 +442,7 @@ fn turn_held_run(
     sweep: &ColliderSweep,
     slop: f32,
 ) -> Option<Turned> {
-    let SegmentContact { t, before, reach, ref contact, .. } = *found;
+    let SegmentContact { t, mut before, reach, ref contact, .. } = *found;
     let half_height = sweep.shape.capsule().map_or(0.0, |(_, half_height)| half_height);
     let normal = sweep.end.rotation * contact.normal;
     let mut turn = turn_out(p[0], p[k].lerp(p[k + 1], t as f64), normal, contact.depth)?;
@@ -454,6 +452,7 @@ fn turn_held_run(
         if contact.overlapping_at_start {
             turned.moved_start = true;
             turned.drift += 2.0 * turn_about_root(&mut start[..=k + 1], turn);
+            before = sweep.start.to_local(start[k].lerp(start[k + 1], t as f64));
         }
         let point = p[k].lerp(p[k + 1], t as f64);
         let Some(left) = contact_outside(before, sweep.end.to_local(point), reach, half_height, slop) else { break };

@@ -125,11 +125,12 @@ fn solve_direct(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> 
     fall_back(p, lengths, s)
 }
 
-/// [`solve_prepared`] for the contact rounds that end a substep: a particle with a contact normal in
-/// `normals` (one per particle; zero for none) slides on its collider's surface, moving only across the
-/// normal, so the lengths stop undoing the contact pass. Where that direct solve fails (the contacts pin
-/// the chain), the lengths are met as [`solve_prepared`] meets them, contacts aside. Returns `false` when
-/// neither direct solve converged.
+/// [`solve_prepared`] for a contact round that ends a substep where some particles slide on a collider: a
+/// particle with a contact normal in `normals` (one per particle; zero for none) moves only across it, so
+/// the lengths stop undoing the contact that gave it. The direct solve runs so restricted and, where it
+/// fails, the Gauss-Newton fallback too; where that fails as well, the lengths are met as [`solve_prepared`]
+/// meets them (contacts aside), from the positions this was given. Returns `false` when the restricted
+/// direct solve failed (a fallback ran).
 pub fn solve_sliding(p: &mut [DVec3], lengths: &[f32], normals: &[Vec3], s: &mut ConstraintScratch) -> bool {
     let m = lengths.len();
     debug_assert!(p.len() == m + 1 && normals.len() == m + 1 && s.start_bonds.len() >= m);
@@ -138,13 +139,16 @@ pub fn solve_sliding(p: &mut [DVec3], lengths: &[f32], normals: &[Vec3], s: &mut
     if newton_along_directions(p, &s.start_bonds[..m], &sliding, l2, inv_l2, &mut s.newton) {
         return true;
     }
+    // The Gauss-Newton projection moves `p` as it goes: keep the given positions for the unrestricted solve.
+    s.newton.corrected[..=m].copy_from_slice(p);
     for k in 0..m {
         s.current_bonds[k] = p[k + 1] - p[k];
     }
-    if project_relinearized(p, &mut s.current_bonds[..m], &sliding, l2, inv_l2, &mut s.newton) {
-        return false;
+    if !project_relinearized(p, &mut s.current_bonds[..m], &sliding, l2, inv_l2, &mut s.newton) {
+        p.copy_from_slice(&s.newton.corrected[..=m]);
+        solve_prepared(p, lengths, s);
     }
-    solve_prepared(p, lengths, s)
+    false
 }
 
 /// Which moves the solve may give each particle (its inverse mass as a projection).
@@ -395,7 +399,8 @@ fn project_relinearized(
 }
 
 /// Newton iterations on the multipliers `mu` of corrections along the directions `d` (one per bond):
-/// particle `j` moves by `d[j-1] mu[j-1] - d[j] mu[j]` (the root not at all). Applies them to `p` and returns
+/// particle `j` moves by `d[j-1] mu[j-1] - d[j] mu[j]` (the root not at all), or by the part of that its
+/// `mobility` allows. Applies them to `p` and returns
 /// `true` when converged, leaves `p` untouched otherwise.
 ///
 /// Each iteration is one pass root to tip that evaluates the bonds under the current multipliers and runs

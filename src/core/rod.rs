@@ -157,7 +157,8 @@ pub struct RodScratch {
     p_old: Vec<DVec3>,
     constraints: ConstraintScratch,
     bounds: SegmentBounds,
-    /// The contact normal of each particle that the last iteration's contact passes moved (zero for none).
+    /// The contact normal of each particle that slides on a collider in the contact rounds' lengths solves
+    /// (`collision::collide`; zero for none), since the last iteration's contact pass.
     normals: Vec<Vec3>,
 }
 
@@ -246,6 +247,7 @@ pub fn substep(
             let normals = &mut normals[..n];
             normals.fill(Vec3::ZERO);
             let mut pass = collide(&mut state.x, p, contacts, bounds, normals);
+            let mut sliding = pass.sliding;
             inextensible::prepare(&state.x, lengths, constraints);
             report.contact_pairs += pass.tested;
             // A collider pushing hard (a swinging arm) moves a few particles far in one substep; the rest of
@@ -257,8 +259,14 @@ pub fn substep(
                     }
                     // Joints the contacts gave a normal slide on their colliders here, so the lengths do not
                     // undo those contacts round after round (bug 9 in docs/robustness.md).
-                    report.fallback |= !inextensible::solve_sliding(p, lengths, normals, constraints);
+                    let direct = if sliding {
+                        inextensible::solve_sliding(p, lengths, normals, constraints)
+                    } else {
+                        inextensible::solve_prepared(p, lengths, constraints)
+                    };
+                    report.fallback |= !direct;
                     pass = collide(&mut state.x, p, contacts, bounds, normals);
+                    sliding |= pass.sliding;
                     inextensible::prepare(&state.x, lengths, constraints);
                     report.contact_pairs += pass.tested;
                 }

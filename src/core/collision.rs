@@ -81,12 +81,16 @@ impl SegmentBounds {
 
     fn compute(&mut self, start: &[DVec3], p: &[DVec3], radii: &[f32]) {
         self.bounds.clear();
-        self.bounds.extend((0..p.len() - 1).map(|k| {
+        // Each joint's travel once, for the two segments it ends.
+        let mut travel_before = (p[0] - start[0]).length();
+        for k in 0..p.len() - 1 {
             let half = (p[k + 1] - p[k]).length() * 0.5;
-            let travel = (p[k] - start[k]).length().max((p[k + 1] - start[k + 1]).length());
+            let travel_after = (p[k + 1] - start[k + 1]).length();
+            let travel = travel_before.max(travel_after);
+            travel_before = travel_after;
             let thickness = radii[k].max(radii[k + 1]) as f64;
-            (p[k].midpoint(p[k + 1]), thickness + half + travel)
-        }));
+            self.bounds.push((p[k].midpoint(p[k + 1]), thickness + half + travel));
+        }
     }
 }
 

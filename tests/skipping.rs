@@ -63,6 +63,43 @@ fn a_settled_chain_sleeps_where_it_would_rest() {
 
 /// The slice read-backs (`read_world`, `read_chain_world`) agree with the visitor on an engine whose chains
 /// have different lengths, one asleep and one awake, so every chain's offset in the shared buffer counts.
+/// A collider that does not move keeps its pose to the bit in every substep: interpolating a pose with itself
+/// can round off it. Before, whenever a step left time in the accumulator (frames of 1/50 s at 240 Hz), a still
+/// sphere at ordinary coordinates counted as moving, so a chain within its reach never slept, and a still
+/// ground plane was never out of reach of any chain.
+#[test]
+fn still_colliders_let_chains_sleep_and_fall_out_of_reach() {
+    let base = straight_chain(8, Vec3::ZERO, Vec3::new(1.0, -0.5, 0.0), 0.05);
+    let params = ChainParams { damping: 3.0, ..Default::default() };
+    let step = |engine: &mut Engine, seconds: f32| {
+        for _ in 0..(seconds * 50.0) as usize {
+            engine.step(1.0 / 50.0, CAMERA, at(HEAD)).unwrap();
+        }
+    };
+    // A sphere within the chain's reach (0.35 m from its root) on the side it does not hang to.
+    let mut near_sphere = engine_with(EngineSettings::default());
+    let chain = near_sphere.create_chain(params, &base).unwrap();
+    let sphere = ColliderDef {
+        shape: ColliderShape::Sphere { radius: 0.05 },
+        transform: Transform::new(HEAD + Vec3::new(-0.213, 0.137, 0.071), Quat::from_rotation_y(0.3)),
+        layers: 1,
+    };
+    near_sphere.create_collider(&sphere).unwrap();
+    step(&mut near_sphere, 30.0);
+    assert!(near_sphere.is_chain_asleep(chain).unwrap(), "the chain never fell asleep next to a still sphere");
+    // A tilted ground plane 1.137 m under the root, beyond the chain's reach: never tested.
+    let mut over_ground = engine_with(EngineSettings { sleep_speed: 0.0, ..Default::default() });
+    over_ground.create_chain(params, &base).unwrap();
+    let ground = ColliderDef {
+        shape: ColliderShape::Plane,
+        transform: Transform::new(HEAD - Vec3::new(0.0, 1.137, 0.0), Quat::from_rotation_x(0.1)),
+        layers: 1,
+    };
+    over_ground.create_collider(&ground).unwrap();
+    step(&mut over_ground, 2.0);
+    assert_eq!(over_ground.stats().contact_pairs_tested, 0, "a still plane out of reach was tested");
+}
+
 #[test]
 fn read_backs_agree_with_the_visitor_chain_by_chain() {
     let mut engine = engine_with(EngineSettings::default());

@@ -851,7 +851,14 @@ impl Engine {
         for s in 0..substeps {
             for &slot in &self.collider_order {
                 let collider = self.colliders.at(slot as usize).expect("live");
-                let pose = |t: f32| ColliderPose::new(&collider.previous.interpolate(&collider.current, t), origin);
+                // A still collider keeps its pose to the bit: interpolating a pose with itself can round off it,
+                // which made a still ground plane or sphere count as moving (never out of reach, never letting
+                // a chain near it sleep).
+                let still = same_bits(&collider.previous, &collider.current);
+                let pose = |t: f32| {
+                    let at = if still { collider.current } else { collider.previous.interpolate(&collider.current, t) };
+                    ColliderPose::new(&at, origin)
+                };
                 sweeps.push(ColliderSweep { shape: collider.shape, start: pose(at_start(s)), end: pose(at_end(s)) });
             }
         }

@@ -229,11 +229,18 @@ impl Chain {
     /// [`for_each_world_transform`](Self::for_each_world_transform) into `out` (the chain's joint count): a
     /// copy of the stored pose for a sleeping chain.
     pub(crate) fn write_world(&self, out: &mut [Transform]) {
+        self.write_world_as(out, |world| world);
+    }
+
+    /// [`write_world`](Self::write_world), each transform converted by `convert`.
+    pub(crate) fn write_world_as<T>(&self, out: &mut [T], convert: impl Fn(Transform) -> T) {
         if self.shows_stored_pose() {
-            out.copy_from_slice(&self.asleep_world);
+            for (slot, world) in out.iter_mut().zip(&self.asleep_world) {
+                *slot = convert(*world);
+            }
         } else {
-            for (world, local) in out.iter_mut().zip(&self.output) {
-                *world = self.anchor.mul(local);
+            for (slot, local) in out.iter_mut().zip(&self.output) {
+                *slot = convert(self.anchor.mul(local));
             }
         }
     }

@@ -901,11 +901,18 @@ impl Engine {
 
     /// World transforms of every joint of every chain, in creation order. Returns how many were written.
     pub fn read_world(&self, out: &mut [Transform]) -> Result<usize> {
+        self.read_world_as(out, |world| world)
+    }
+
+    /// [`read_world`](Self::read_world) into a host's own transform type, each converted by `convert` (the
+    /// C ABI's `kdw_transform`): one pass over every chain's joints, with no call per joint to a callback that
+    /// the compiler cannot inline.
+    pub fn read_world_as<T>(&self, out: &mut [T], convert: impl Fn(Transform) -> T) -> Result<usize> {
         self.check_capacity(out.len())?;
         let mut written = 0;
         for chain in self.chains_in_order() {
             let joints = chain.joint_count();
-            chain.write_world(&mut out[written..written + joints]);
+            chain.write_world_as(&mut out[written..written + joints], &convert);
             written += joints;
         }
         Ok(written)
@@ -913,7 +920,24 @@ impl Engine {
 
     /// Local rotations (see [`for_each_local_rotation`](Self::for_each_local_rotation)) into `out`.
     pub fn read_local_rotations(&self, out: &mut [Quat]) -> Result<usize> {
-        fill_slice(out, |capacity, f| self.for_each_local_rotation(capacity, f))
+        self.read_local_rotations_as(out, |rotation| rotation)
+    }
+
+    /// [`read_local_rotations`](Self::read_local_rotations) into a host's own quaternion type, each converted by
+    /// `convert` (see [`read_world_as`](Self::read_world_as)).
+    pub fn read_local_rotations_as<T>(&self, out: &mut [T], convert: impl Fn(Quat) -> T) -> Result<usize> {
+        self.check_capacity(out.len())?;
+        let mut written = 0;
+        for chain in self.chains_in_order() {
+            let joints = chain.joint_count();
+            let mut parent = Quat::IDENTITY;
+            for (slot, local) in out[written..written + joints].iter_mut().zip(&chain.output) {
+                *slot = convert(relative_rotation(parent, local.rotation));
+                parent = local.rotation;
+            }
+            written += joints;
+        }
+        Ok(written)
     }
 
     /// Calls `f` with the world transform of each joint of one chain; fails without calling it when

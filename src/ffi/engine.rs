@@ -1,7 +1,7 @@
 //! `kdw_engine`: create, configure, step, read back.
 
 use super::guard::{
-    check_out, check_struct_size, destroy_handle, fill, guard, into_handle, query, read, slice, slice_mut, store_each,
+    check_out, check_struct_size, destroy_handle, fill, guard, into_handle, query, read, slice, slice_mut,
     with_engine_mut, write,
 };
 use super::status::{KDW_STATUS_OK, kdw_status};
@@ -157,7 +157,7 @@ pub extern "C" fn kdw_engine_step_and_read(
                     return Err(crate::core::Error::buffer_too_small(message).into());
                 }
                 e.step_with_anchors(anchors.iter().map(|t| Transform::from(*t)), dt, (*camera).into(), (*k).into())?;
-                store_each(out, |capacity, f| e.for_each_local_rotation(capacity, f))
+                Ok(e.read_local_rotations_as(out, kdw_quat::from)?)
             })
         }?;
         // SAFETY: checked by check_out.
@@ -227,7 +227,7 @@ pub extern "C" fn kdw_engine_read_world(
     out_written: *mut u32,
 ) -> kdw_status {
     fill(engine, out_transforms, capacity, out_written, "out_transforms", |e, out| {
-        store_each(out, |capacity, f| e.for_each_world_transform(capacity, f))
+        Ok(e.read_world_as(out, kdw_transform::from)?)
     })
 }
 
@@ -241,7 +241,7 @@ pub extern "C" fn kdw_engine_read_local_rotations(
     out_written: *mut u32,
 ) -> kdw_status {
     fill(engine, out_rotations, capacity, out_written, "out_rotations", |e, out| {
-        store_each(out, |capacity, f| e.for_each_local_rotation(capacity, f))
+        Ok(e.read_local_rotations_as(out, kdw_quat::from)?)
     })
 }
 

@@ -400,8 +400,7 @@ fn project_relinearized(
 
 /// Newton iterations on the multipliers `mu` of corrections along the directions `d` (one per bond):
 /// particle `j` moves by `d[j-1] mu[j-1] - d[j] mu[j]` (the root not at all), or by the part of that its
-/// `mobility` allows. Applies them to `p` and returns
-/// `true` when converged, leaves `p` untouched otherwise.
+/// `mobility` allows. Applies them to `p` and returns `true` when converged, leaves `p` untouched otherwise.
 ///
 /// Each iteration is one pass root to tip that evaluates the bonds under the current multipliers and runs
 /// the forward elimination of the Thomas algorithm on the tridiagonal Newton system `J delta = -F/2`

@@ -73,8 +73,8 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
                 if !again.any() {
                     break;
                 }
-                // Lanes with a joint that slides on a collider take the scalar solve that lets it; with none
-                // sliding that solve is the vector one's, to the bit.
+                // Lanes with a joint that slides on a collider take the scalar sliding solve, lane by lane (as
+                // the scalar solver does); the others the vector solve, as before.
                 let sliding = contacts::sliding(g, again);
                 let vector = again.and(sliding.not());
                 if vector.any() {

@@ -245,6 +245,15 @@ impl Chain {
         }
     }
 
+    /// Each joint's rotation relative to its parent (joint 0: relative to the anchor).
+    pub(crate) fn local_rotations(&self) -> impl Iterator<Item = Quat> + '_ {
+        self.output.iter().scan(Quat::IDENTITY, |parent, local| {
+            let relative = relative_rotation(*parent, local.rotation);
+            *parent = local.rotation;
+            Some(relative)
+        })
+    }
+
     /// Calls `f` with each joint's world transform (the anchor times the output pose).
     pub(crate) fn for_each_world_transform(&self, mut f: impl FnMut(Transform)) {
         if self.shows_stored_pose() {

@@ -9,7 +9,7 @@ use glam::{Quat, Vec3};
 
 use super::arena::{Arena, Id, Kind};
 use super::buffers::reserve_total;
-use super::chain::{Chain, ViewShape, ViewShapeId, output_fraction, relative_rotation, same_bits};
+use super::chain::{Chain, ViewShape, ViewShapeId, output_fraction, same_bits};
 use super::collider::{Collider, ColliderDef, ColliderId, ColliderPose, ColliderSweep};
 use super::collision::ContactInput;
 use super::error::{Error, Result};
@@ -890,11 +890,7 @@ impl Engine {
     pub fn for_each_local_rotation(&self, capacity: usize, mut f: impl FnMut(Quat)) -> Result<()> {
         self.check_capacity(capacity)?;
         for chain in self.chains_in_order() {
-            let mut parent = Quat::IDENTITY;
-            for local in &chain.output {
-                f(relative_rotation(parent, local.rotation));
-                parent = local.rotation;
-            }
+            chain.local_rotations().for_each(&mut f);
         }
         Ok(())
     }
@@ -930,10 +926,8 @@ impl Engine {
         let mut written = 0;
         for chain in self.chains_in_order() {
             let joints = chain.joint_count();
-            let mut parent = Quat::IDENTITY;
-            for (slot, local) in out[written..written + joints].iter_mut().zip(&chain.output) {
-                *slot = convert(relative_rotation(parent, local.rotation));
-                parent = local.rotation;
+            for (slot, rotation) in out[written..written + joints].iter_mut().zip(chain.local_rotations()) {
+                *slot = convert(rotation);
             }
             written += joints;
         }

@@ -418,18 +418,18 @@ fn ropes_rooted_inside_a_collider_match_the_scalar_solver() {
             assert_eq!(particle_bits(&lanes, id), particle_bits(&scalar, scalar_id), "frame {frame}");
         }
     }
-    // The held joints stayed out of the contacts, and the joints past them are out of the sphere.
+    // The joints past the held ones (2 x 9 mm of rest length from the root) are out of the sphere's reach.
     let head_pose = head(29);
     let deepest = ids
         .iter()
-        .flat_map(|&id| chain_world(&lanes, id).into_iter().skip(6))
-        .map(|joint| HEAD_RADIUS - (joint.position - head_pose.position).length())
+        .flat_map(|&id| chain_world(&lanes, id).into_iter().skip(5))
+        .map(|joint| HEAD_RADIUS + 0.02 - (joint.position - head_pose.position).length())
         .fold(f32::NEG_INFINITY, f32::max);
     println!(
         "ropes rooted inside the head sphere's reach, 0.5 s: the same bits on both solvers, {} contact pairs, \
-         {} fallbacks; deepest joint centre past the held ones {deepest:.1e} m inside the sphere",
+         {} fallbacks; deepest joint past the held ones {deepest:.1e} m inside the sphere's reach",
         lanes.stats().contact_pairs_tested,
         lanes.stats().solver_fallbacks
     );
-    assert!(deepest <= 0.0, "{deepest}");
+    assert!(deepest <= 1e-4, "{deepest}");
 }

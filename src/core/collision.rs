@@ -304,9 +304,10 @@ fn collide_outside(
     if held.joints > 0 && held.joints < bounds.len() {
         let k = held.joints;
         let found = segment_contact(k, bounds[k], start, p, sweep, input, &collider, *drift);
-        if let Some(turned) = found.and_then(|found| turn_held_run(start, p, k, &found, sweep, input.slop)) {
+        let turned = found.as_ref().and_then(|found| turn_held_run(start, p, k, found, sweep, &collider, input.slop));
+        if let (Some(found), Some(turned)) = (found, turned) {
             touching = true;
-            deepest = deepest.max(turned.depth);
+            deepest = deepest.max(found.contact.depth);
             *drift += turned.drift;
             moved_start |= turned.moved_start;
             if let Some(normals) = normals {
@@ -423,10 +424,9 @@ fn turn_out(root: DVec3, point: DVec3, normal: Vec3, depth: f32) -> Option<DQuat
     (angle <= MAX_TURN).then(|| DQuat::from_axis_angle(axis / arm, angle))
 }
 
-/// What [`turn_held_run`] did: the depth of the contact it met, how far it moved joints (for the quick
-/// reject's drift), whether it moved start positions, and the contact normal of its last turn.
+/// What [`turn_held_run`] did: how far it moved joints (for the quick reject's drift), whether it moved start
+/// positions, and the contact normal of its last turn.
 struct Turned {
-    depth: f32,
     drift: f64,
     moved_start: bool,
     normal: Vec3,
@@ -444,13 +444,13 @@ fn turn_held_run(
     k: usize,
     found: &SegmentContact,
     sweep: &ColliderSweep,
+    collider: &OutsideCollider,
     slop: f32,
 ) -> Option<Turned> {
     let SegmentContact { t, mut before, reach, ref contact, .. } = *found;
-    let half_height = sweep.shape.capsule().map_or(0.0, |(_, half_height)| half_height);
     let normal = sweep.end.rotation * contact.normal;
     let mut turn = turn_out(p[0], p[k].lerp(p[k + 1], t as f64), normal, contact.depth)?;
-    let mut turned = Turned { depth: contact.depth, drift: 0.0, moved_start: false, normal };
+    let mut turned = Turned { drift: 0.0, moved_start: false, normal };
     for _ in 0..TURN_STEPS {
         turned.drift += 2.0 * turn_about_root(&mut p[..=k + 1], turn);
         if contact.overlapping_at_start {
@@ -459,7 +459,9 @@ fn turn_held_run(
             before = sweep.start.to_local(start[k].lerp(start[k + 1], t as f64));
         }
         let point = p[k].lerp(p[k + 1], t as f64);
-        let Some(left) = contact_outside(before, sweep.end.to_local(point), reach, half_height, slop) else { break };
+        let Some(left) = contact_outside(before, sweep.end.to_local(point), reach, collider.half_height, slop) else {
+            break;
+        };
         turned.normal = sweep.end.rotation * left.normal;
         let Some(next) = turn_out(p[0], point, turned.normal, left.depth) else { break };
         turn = next;

@@ -1,6 +1,7 @@
 //! Which colliders a chain can touch during a step (the broad phase): a collider on a layer of the chain's
-//! mask whose swept bounding sphere meets the chain's, or, for a ground plane, whose half-space it reaches. The engine asks when it decides whether a chain is
-//! still, and the lane solver asks again for the chains it steps, so neither keeps a list per chain.
+//! mask whose swept bounding sphere meets the chain's, or, for a ground plane, whose half-space it reaches.
+//! The engine asks when it decides whether a chain is still, and the lane solver asks again for the chains it
+//! steps, so neither keeps a list per chain.
 
 use glam::Vec3;
 

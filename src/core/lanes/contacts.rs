@@ -127,14 +127,10 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, fresh: bool
             contact.normals.resize(n, Vec3::ZERO);
             contact.sliding = false;
         }
-        let input = ContactInput {
-            colliders: &contact.sweeps,
-            radii: &contact.radii,
-            lengths: &contact.lengths,
-            friction: contact.friction,
-            slop: contact.slop,
-        };
-        let pass = collision::collide(lane_x, lane_p, &input, segment_bounds, &mut contact.normals);
+        // Out of `contact` for the pass, which reads the rest of it (a move: no allocation).
+        let mut normals = std::mem::take(&mut contact.normals);
+        let pass = collision::collide(lane_x, lane_p, &contact.input(), segment_bounds, &mut normals);
+        contact.normals = normals;
         contact.sliding |= pass.sliding;
         contact.pass = Some(pass);
         tested += pass.tested;

@@ -5,7 +5,7 @@
 //! by the dynamic joints and substeps printed. Scenes: `100x16`, `1000x16`, `1x1000` (0.8 m rope), `1x1000_hair`
 //! (2.5 cm segments); variants: `lanes` (default), `scalar`, `colliders`
 //! (the head sphere, shoulders and ground of the report's colliders variant, on the lane solver) and
-//! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair), `lod1` and `lod2`, `views`
+//! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair), `lod1` and `lod2`, `views`, `limp`
 //! (three view shapes per chain, orbiting camera). It also prints the
 //! engine's state hash and the contact pairs tested, so that two builds can be checked to compute the same
 //! bits on a scene, and last the mean time of a frame, for `tools/ab.sh` (interleaved timing of two builds:
@@ -15,13 +15,13 @@
 mod scenes;
 
 use scenes::{
-    ASLEEP, AWAKE_AT_REST, COLLIDERS, COLLIDERS_SCALAR, LOD1, LOD2, PLAIN, PLAIN_SCALAR, ReadBack, Scene, SceneRun,
-    VIEWS,
+    ASLEEP, AWAKE_AT_REST, COLLIDERS, COLLIDERS_SCALAR, LIMP, LOD1, LOD2, PLAIN, PLAIN_SCALAR, ReadBack, Scene,
+    SceneRun, VIEWS,
 };
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest|lod1|lod2|views]";
+    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest|lod1|lod2|views|limp]";
     let frames: u64 = args.first().and_then(|f| f.parse().ok()).expect(usage);
     let scene = match args.get(1).map(String::as_str) {
         Some("100x16") => Scene::uniform("100x16", 100, 16),
@@ -39,6 +39,7 @@ fn main() {
         Some("lod1") => LOD1,
         Some("lod2") => LOD2,
         Some("views") => VIEWS,
+        Some("limp") => LIMP,
         _ => PLAIN,
     };
     let mut run = SceneRun::new(&scene, variant, ReadBack::World).expect("the scene builds");

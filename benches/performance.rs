@@ -13,6 +13,8 @@
 //! chain does not use) and the lane solver's speed-up are measured interleaved, so a change of load on the
 //! shared machine cannot fake or hide a difference.
 
+#[path = "support/peak.rs"]
+mod peak;
 #[path = "support/peer_pendulum.rs"]
 mod peer_pendulum;
 #[cfg(feature = "peers")]
@@ -530,15 +532,27 @@ fn ns_per_joint(report: &Report, scene: &str, variant: &str) -> Option<f64> {
     report.scene(scene, variant).and_then(SceneRow::ns_per_joint_substep)
 }
 
-fn targets(report: &Report) -> Vec<Target> {
+fn targets(report: &Report, bound: &Bound) -> Vec<Target> {
     let mut out = Vec::new();
 
-    let frame = report.scene("1000x16", PLAIN.id).and_then(|r| r.frame_seconds);
+    let plain = report.scene("1000x16", PLAIN.id);
+    let frame = plain.and_then(|r| r.frame_seconds);
     let everything = report.scene("1000x16", VIEWS_COLLIDERS.id).and_then(|r| r.frame_seconds);
     out.push(Target::check(
         "1000 x 16 joints <= 1 ms per 60 Hz frame",
         format!("{} us plain ({} us with view shapes and colliders)", micros(frame), micros(everything)),
         frame.map(|s| s <= 1e-3),
+    ));
+    let over_bound = plain.and_then(SceneRow::ns_per_joint_substep).map(|ns| ns / (bound.lanes() * 1e9));
+    out.push(Target::check(
+        "1000 x 16 within 3x of the compute / memory bound (the lower bound section)",
+        over_bound.map_or("not run".into(), |r| {
+            format!(
+                "{r:.1}x the bound of {:.1} ns/joint/substep (measured peaks, operations counted)",
+                bound.lanes() * 1e9
+            )
+        }),
+        over_bound.map(|r| r <= 3.0),
     ));
 
     let asleep = report.scene(CONTROLS_SCENE, ASLEEP.id).filter(|r| r.note.is_none()).and_then(|r| r.frame_seconds);
@@ -709,7 +723,9 @@ fn main() {
     criterion.final_summary();
 
     let Some(machine) = machine else { return };
-    report.targets = targets(&report);
+    let substeps = report.scene("1000x16", PLAIN.id).map_or(4.0, |r| r.substeps.max(1) as f64);
+    let bound = Bound::new(&machine, substeps);
+    report.targets = targets(&report, &bound);
     report.notes.push(format!(
         "The machine is shared (load average at the start {}, at the end {}): criterion medians of scenes measured \
          one after the other can differ by several percent, at times tens of percent, through other processes alone. \
@@ -717,9 +733,6 @@ fn main() {
         machine.load_average.as_deref().unwrap_or("unknown"),
         std::fs::read_to_string("/proc/loadavg").map_or("unknown".into(), |s| s.trim().to_owned())
     ));
-    let substeps = report.scene("1000x16", PLAIN.id).map_or(4.0, |r| r.substeps.max(1) as f64);
-    let simd_lanes = if kodawari::simd_path() == "avx512" { 16.0 } else { 8.0 };
-    let bound = Bound::new(&machine, substeps, simd_lanes);
     let markdown = report.markdown(&machine, &solver_path(), &bound, started.elapsed());
     let complete = !report.scenes.iter().any(|r| r.missing.as_deref() == Some(FILTERED_OUT));
     let path = if complete { Path::new("docs/performance.md") } else { Path::new("target/performance-partial.md") };

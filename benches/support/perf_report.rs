@@ -11,6 +11,8 @@ use std::fmt::Write as _;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
+use crate::peak::Peak;
+
 // ---- allocation counting -----------------------------------------------------------------------------
 
 /// The tests' counting allocator, so the report can show that a frame allocates nothing.
@@ -139,6 +141,8 @@ pub struct Machine {
     pub rustc: Option<String>,
     /// Single-thread streaming bandwidth (bytes/s), measured here.
     pub bandwidth: f64,
+    /// Single-thread arithmetic peaks, measured here.
+    pub peak: Peak,
 }
 
 impl Machine {
@@ -173,6 +177,7 @@ impl Machine {
             load_average: read("/proc/loadavg"),
             rustc,
             bandwidth: stream_bandwidth(),
+            peak: Peak::measure(kodawari::simd_path() == "avx512"),
         }
     }
 }
@@ -198,29 +203,35 @@ fn stream_bandwidth() -> f64 {
 
 // ---- a lower bound for the rod --------------------------------------------------------------------------
 
-/// Work of one internal substep per dynamic joint at default settings, counted from the code in
-/// `src/core/rod.rs`, `polar.rs` and `inextensible.rs`. Counting rule: add, multiply, divide and square root
-/// 1 operation each; sin, cos, acos 20 each. Loop control, comparisons and conversions are free. Where
-/// the code iterates to a tolerance, the minimum it runs is counted (1 polar iteration per group, one
-/// Newton update per inextensibility solve), so the total is a lower bound for this algorithm.
-pub const SUBSTEP_OPERATIONS: [(&str, f64); 5] = [
-    // Velocity update relative to the root (12), angular decay (3), position predict in f64 (6), rotation
-    // predict: scaled axis to quaternion (~55 with one sin_cos), quaternion product (28), normalise (13).
-    ("predict", 117.0),
-    // Per iteration (2 at default): group centroid and rest centroid (18); per particle of the group (3):
-    // rotation to rest (28), quaternion to matrix (24), weighted add (18), outer product and add (24) = 94;
-    // one polar iteration (~174: matrix from quaternion, 3 cross and 3 dot products, axis-angle with one
-    // sin_cos, product, normalise) plus its guard (18); goals for 3 particles (3 x 45); orientation nlerp
-    // (60). 18 + 282 + 192 + 135 + 60 = 687, times 2.
-    ("shape matching, 2 iterations", 1374.0),
-    // Per iteration and bond: directions (3), two residual evaluations (2 x 35), Jacobian (22), Thomas
-    // forward and back (10), applying the multipliers (15) = 120, times 2.
-    ("inextensibility, 2 iterations", 240.0),
-    // Linear velocity (6), relative rotation (28), hemisphere and scaled axis with one acos (~36), scale (3).
-    ("velocities", 73.0),
+/// Work of one internal substep per dynamic joint at default settings, counted from the lane kernel's code
+/// (`src/core/lanes/`: the scalar solver's operations, lane by lane), as (single-precision, double-precision)
+/// operations. Counting rule: add, subtract, multiply, divide and square root 1 operation each; loop control,
+/// comparisons, selects and conversions free. Building blocks: quaternion product 28, quaternion to matrix
+/// 24, normalise 13, the exponential's series 26, the logarithm's series 21. Where the code iterates to a
+/// tolerance the minimum it runs is counted (one polar step per group, one forward pass and one back
+/// substitution per inextensibility solve), so the total is a lower bound for the algorithm as written.
+pub const SUBSTEP_OPERATIONS: [(&str, f64, f64); 5] = [
+    // Velocity relative to the root, decay and gravity (15), angular decay (3), position predict (3 f32, 3
+    // f64), orientation predict: scaled turn (3), exponential (26), product (28), normalise (13).
+    ("predict", 91.0, 3.0),
+    // Per iteration (2 at default) of an interior group: 2 orientation terms (product 28, to matrix 24, weight
+    // 9) = 122; centroid (9 adds, 3 divisions: f64); 3 offsets from it (9 f64), outer products (27) and the
+    // sum of 6 matrices (45); the polar step: its guard (20), one step (rotation matrix 24, S = R^T A 45,
+    // gradient and trace 5, Mueller's step 5, convergence 5, the Newton step 58, exponential 26, product 28,
+    // renormalise 13 = 209), the final matrix (24); goals for 3 particles (matrix times offset 15 each; in
+    // f64 the goal and the pull, 12 each); orientation: product (28) and nlerp (33). Per iteration 553 f32 and
+    // 57 f64, times 2.
+    ("shape matching, 2 iterations", 1106.0, 114.0),
+    // Start bonds (3, once per substep); per iteration and bond, all f64: the forward pass row (bond 3,
+    // residual 7, three dot products 15, elimination 9 = 34), back substitution (2), the error after the step
+    // (18), applying the multipliers (12) = 66, times 2.
+    ("inextensibility, 2 iterations", 0.0, 135.0),
+    // Linear velocity (3 f64, 3 f32); relative rotation (28), hemisphere (7), logarithm's series (21), scale
+    // (3).
+    ("velocities", 62.0, 3.0),
     // Per frame, shared by the 4 substeps of a 60 Hz frame: local capture (2 x ~40), interpolated output
     // (~60), world read-back (~35) = 175 / 4.
-    ("output and read-back, per substep share", 44.0),
+    ("output and read-back, per substep share", 44.0, 0.0),
 ];
 
 /// Bytes a frame streams per joint when the scene does not fit in cache (the chain loop runs all substeps
@@ -243,34 +254,40 @@ pub const FRAME_BYTES: [(&str, f64); 5] = [
 pub const WORKING_SET_BYTES_PER_JOINT: f64 = 236.0;
 
 pub struct Bound {
-    pub operations_per_joint_substep: f64,
+    /// Single- and double-precision operations (`SUBSTEP_OPERATIONS`).
+    pub f32_operations: f64,
+    pub f64_operations: f64,
     pub bytes_per_joint_frame: f64,
-    /// Seconds per joint per substep if the operations ran at the scalar peak.
-    pub scalar_compute: Option<f64>,
-    /// Same for the f32 SIMD path that ran at its peak: `simd_lanes` lanes (16 with AVX-512, 8 with AVX2).
-    pub simd_compute: Option<f64>,
-    pub simd_lanes: f64,
+    /// Seconds per joint per substep if the operations ran at the measured scalar peak.
+    pub scalar_compute: f64,
+    /// Same at the measured SIMD peaks of the widest kernel that ran, each precision at its own rate.
+    pub simd_compute: f64,
+    pub peak: Peak,
     /// Seconds per joint per substep to stream the frame's bytes at the measured bandwidth.
     pub memory: f64,
 }
 
-/// Scalar peak assumption: 4 floating-point operations per cycle (two multiply/FMA pipes and two add pipes,
-/// fusion not counted), as on current x86-64 and aarch64 cores.
-pub const SCALAR_OPERATIONS_PER_CYCLE: f64 = 4.0;
 impl Bound {
-    /// `simd_lanes`: the lane count of the widest kernel the lane solver ran.
-    pub fn new(machine: &Machine, substeps_per_frame: f64, simd_lanes: f64) -> Self {
-        let operations: f64 = SUBSTEP_OPERATIONS.iter().map(|(_, n)| n).sum();
+    pub fn new(machine: &Machine, substeps_per_frame: f64) -> Self {
+        let f32_operations: f64 = SUBSTEP_OPERATIONS.iter().map(|(_, single, _)| single).sum();
+        let f64_operations: f64 = SUBSTEP_OPERATIONS.iter().map(|(_, _, double)| double).sum();
         let bytes: f64 = FRAME_BYTES.iter().map(|(_, n)| n).sum();
-        let scalar = machine.mhz.map(|mhz| operations / (SCALAR_OPERATIONS_PER_CYCLE * mhz * 1e6));
+        let peak = machine.peak;
         Self {
-            operations_per_joint_substep: operations,
+            f32_operations,
+            f64_operations,
             bytes_per_joint_frame: bytes,
-            scalar_compute: scalar,
-            simd_compute: scalar.map(|s| s / simd_lanes),
-            simd_lanes,
+            // The scalar solver's doubles run at its floats' rate: one lane either way.
+            scalar_compute: (f32_operations + f64_operations) / peak.scalar_f32,
+            simd_compute: f32_operations / peak.simd_f32 + f64_operations / peak.simd_f64,
+            peak,
             memory: bytes / substeps_per_frame / machine.bandwidth,
         }
+    }
+
+    /// The binding bound: the larger of the SIMD compute line and the memory line.
+    pub fn lanes(&self) -> f64 {
+        self.simd_compute.max(self.memory)
     }
 }
 
@@ -441,6 +458,16 @@ impl Report {
             ("SIMD features", machine.simd_flags.join(", ")),
             ("L3 cache", machine.l3_cache.clone().unwrap_or_else(|| "unknown".into())),
             ("single-thread stream bandwidth (measured)", format!("{:.1} GB/s", machine.bandwidth / 1e9)),
+            (
+                "single-thread arithmetic peak (measured: independent multiplies and adds, not fused)",
+                format!(
+                    "scalar {:.1}; {}-lane SIMD f32 {:.1}, f64 {:.1} G lane operations/s",
+                    machine.peak.scalar_f32 / 1e9,
+                    machine.peak.lanes,
+                    machine.peak.simd_f32 / 1e9,
+                    machine.peak.simd_f64 / 1e9
+                ),
+            ),
             ("load average at start", machine.load_average.clone().unwrap_or_else(|| "unknown".into())),
             ("compiler", machine.rustc.clone().unwrap_or_else(|| "unknown".into())),
             ("solver path that ran", simd_path.to_owned()),
@@ -654,15 +681,16 @@ impl Report {
         let measured_scalar = self.scene("1000x16", "plain_scalar").and_then(SceneRow::ns_per_joint_substep);
         let _ = write!(
             md,
-            "## Lower bound for 1000 x 16\n\nOperations per dynamic joint per substep, counted from the code at \
-             default settings (add, multiply, divide, square root = 1; sin, cos, acos = 20; where the code iterates \
-             to a tolerance the minimum it runs is counted, so this is a lower bound for the algorithm as written):\n\n\
-             | part | operations |\n|---|---|\n"
+            "## Lower bound for 1000 x 16\n\nOperations per dynamic joint per substep, counted from the lane kernel's \
+             code at default settings (add, subtract, multiply, divide, square root = 1; where the code iterates to a \
+             tolerance the minimum it runs is counted, so this is a lower bound for the algorithm as written; the \
+             count is itemised in `benches/support/perf_report.rs`):\n\n\
+             | part | f32 operations | f64 operations |\n|---|---|---|\n"
         );
-        for (part, n) in SUBSTEP_OPERATIONS {
-            let _ = writeln!(md, "| {part} | {n:.0} |");
+        for (part, single, double) in SUBSTEP_OPERATIONS {
+            let _ = writeln!(md, "| {part} | {single:.0} | {double:.0} |");
         }
-        let _ = writeln!(md, "| total | {:.0} |\n", bound.operations_per_joint_substep);
+        let _ = writeln!(md, "| total | {:.0} | {:.0} |\n", bound.f32_operations, bound.f64_operations);
         md.push_str(
             "Bytes per joint per frame streamed from memory when the scene does not fit in cache (a chain's substeps \
              run back to back, so its data is loaded once per frame):\n\n| data | bytes |\n|---|---|\n",
@@ -671,32 +699,35 @@ impl Report {
             let _ = writeln!(md, "| {part} | {n:.0} |");
         }
         let _ = writeln!(md, "| total | {:.0} |\n", bound.bytes_per_joint_frame);
-        let ratio = |measured: Option<f64>, b: Option<f64>| match (measured, b) {
-            (Some(m), Some(b)) => format!("{:.1}", m / (b * 1e9)),
-            _ => "-".into(),
-        };
-        let ns_of = |b: Option<f64>| b.map_or("-".into(), |b| format!("{:.1}", b * 1e9));
+        let ratio = |measured: Option<f64>, b: f64| measured.map_or("-".into(), |m| format!("{:.1}", m / (b * 1e9)));
+        let peak = &bound.peak;
         let _ = write!(
             md,
-            "| bound (per joint per substep) | ns | lane solver (plain): measured / bound \
+            "The compute lines run the operations at this core's measured peaks (the machine table): independent \
+             multiplies and adds, never fused, since the kernel's determinism policy rules out fused multiply-adds; \
+             single- and double-precision operations each at their own rate.\n\n\
+             | bound (per joint per substep) | ns | lane solver (plain): measured / bound \
              | scalar solver (plain, scalar solver): measured / bound |\n|---|---|---|---|\n\
-             | compute, scalar peak ({SCALAR_OPERATIONS_PER_CYCLE:.0} operations/cycle at the clock above) \
-             | {} | {} | {} |\n\
-             | compute, {:.0}-lane f32 SIMD peak (the widest kernel that ran) | {} | {} | - |\n\
-             | memory, measured stream bandwidth | {} | {} | {} |\n\n\
+             | compute, scalar peak ({:.1} G operations/s) | {:.1} | {} | {} |\n\
+             | compute, {}-lane SIMD peak (f32 {:.1}, f64 {:.1} G lane operations/s; the widest kernel that ran) \
+             | {:.1} | {} | - |\n\
+             | memory, measured stream bandwidth | {:.1} | {} | {} |\n\n\
              Measured (1000 x 16): lane solver (the default; the plain variant) {} ns/joint/substep, scalar solver \
              {} ns/joint/substep. The lane solver is bounded by the SIMD line, the scalar solver by the scalar one. \
              The 1000 x 16 working set (about {:.1} MB) fits in the L3 cache, so the memory line bounds the 16384 x \
              16 scene rather than this one; compute is the binding bound.\n\n",
-            ns_of(bound.scalar_compute),
+            peak.scalar_f32 / 1e9,
+            bound.scalar_compute * 1e9,
             ratio(measured, bound.scalar_compute),
             ratio(measured_scalar, bound.scalar_compute),
-            bound.simd_lanes,
-            ns_of(bound.simd_compute),
+            peak.lanes,
+            peak.simd_f32 / 1e9,
+            peak.simd_f64 / 1e9,
+            bound.simd_compute * 1e9,
             ratio(measured, bound.simd_compute),
-            ns_of(Some(bound.memory)),
-            ratio(measured, Some(bound.memory)),
-            ratio(measured_scalar, Some(bound.memory)),
+            bound.memory * 1e9,
+            ratio(measured, bound.memory),
+            ratio(measured_scalar, bound.memory),
             ns(measured),
             ns(measured_scalar),
             16_000.0 * WORKING_SET_BYTES_PER_JOINT / 1e6,

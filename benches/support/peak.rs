@@ -1,0 +1,147 @@
+//! The arithmetic peak of one core, measured rather than assumed: how many lane operations per second it
+//! runs when nothing but independent multiplies and adds are in flight. The kernel's determinism policy
+//! (`src/core/lanes/mod.rs`) rules out fused multiply-adds, so neither are they used here: the peak is the
+//! one the code as written could reach. Ratios of the rod's operation counts to these rates give the compute
+//! lines of the report's lower bound.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use multiversion::multiversion;
+use multiversion::target::match_target;
+
+/// Rounds of one timed pass: about 100 ms at a peak of 1e11 lane operations per second for 16 lanes.
+const ROUNDS: u64 = 1 << 20;
+
+/// Lane operations per second, best of a few passes.
+#[derive(Clone, Copy, Debug)]
+pub struct Peak {
+    /// Single precision, one lane at a time (scalar code: the scalar solver's rate).
+    pub scalar_f32: f64,
+    /// Single and double precision, `lanes` lanes per operation, compiled like the lane kernel's widest copy.
+    pub simd_f32: f64,
+    pub simd_f64: f64,
+    pub lanes: usize,
+}
+
+impl Peak {
+    /// `sixteen`: the lane solver ran its 16-lane (AVX-512) kernel; else its 8-lane one.
+    pub fn measure(sixteen: bool) -> Self {
+        let (simd_f32, simd_f64) = if sixteen { (best(f32x16), best(f64x16)) } else { (best(f32x8), best(f64x8)) };
+        Self { scalar_f32: best(f32x1), simd_f32, simd_f64, lanes: if sixteen { 16 } else { 8 } }
+    }
+}
+
+/// The best rate of `run` over 5 passes.
+fn best(run: fn(u64) -> (u64, f64)) -> f64 {
+    let mut best = 0.0f64;
+    for _ in 0..5 {
+        let start = Instant::now();
+        let (operations, value) = run(black_box(ROUNDS));
+        black_box(value);
+        best = best.max(operations as f64 / start.elapsed().as_secs_f64());
+    }
+    best
+}
+
+/// `$chains` independent accumulators of type `$vector` (as many as the vector registers hold), half multiplied
+/// and half added to each round, with the intrinsics `$mul` and `$add` written out so that no compiler pass
+/// can regroup them (the vectoriser, left to itself, spilled or shuffled some widths). Evaluates to the lane
+/// operations run and a value that depends on every one of them.
+macro_rules! chains {
+    ($rounds:expr, $vector:ty, $elem:ty, $lanes:literal, $chains:literal, $splat:expr, $mul:expr, $add:expr, $sum:expr) => {{
+        let mut acc: [$vector; $chains] = std::array::from_fn(|k| $splat(1.0 + k as $elem));
+        // Opaque start values: the compiler can neither merge chains nor fold the rounds.
+        acc = black_box(acc);
+        let (factor, step) = ($splat(black_box(0.999_999_9)), $splat(black_box(1e-7)));
+        for _ in 0..$rounds {
+            for k in (0..$chains).step_by(2) {
+                acc[k] = $mul(acc[k], factor);
+                acc[k + 1] = $add(acc[k + 1], step);
+            }
+        }
+        ($rounds * $chains * $lanes, acc.iter().map($sum).sum::<f64>())
+    }};
+}
+
+// The targets of the lane kernel's copies (`src/core/lanes/mod.rs`). A 16-lane quantity takes one 512-bit
+// register in single precision and two in double: 12 chains of 16 lanes, then 24 of 8 (32 registers). With
+// AVX2, 8 lanes: 12 chains of 8, then 12 of 4 (16 registers).
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
+))]
+fn f32x16(rounds: u64) -> (u64, f64) {
+    // Arrays rather than the 512-bit intrinsics (stable only after the crate's minimum Rust version); the
+    // vectoriser compiles these to one register per chain.
+    chains!(
+        rounds,
+        [f32; 16],
+        f32,
+        16,
+        12,
+        |x| [x; 16],
+        lanewise::<f32, 16>(|a, b| a * b),
+        lanewise::<f32, 16>(|a, b| a + b),
+        |v: &[f32; 16]| v.iter().map(|&x| f64::from(x)).sum::<f64>()
+    )
+}
+
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
+))]
+fn f64x16(rounds: u64) -> (u64, f64) {
+    chains!(
+        rounds,
+        [f64; 16],
+        f64,
+        16,
+        12,
+        |x| [x; 16],
+        lanewise::<f64, 16>(|a, b| a * b),
+        lanewise::<f64, 16>(|a, b| a + b),
+        |v: &[f64; 16]| v.iter().sum::<f64>()
+    )
+}
+
+/// `op` lane by lane.
+#[inline(always)]
+fn lanewise<T: Copy, const L: usize>(op: impl Fn(T, T) -> T) -> impl Fn([T; L], [T; L]) -> [T; L] {
+    move |a, b| std::array::from_fn(|i| op(a[i], b[i]))
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn f32x8(rounds: u64) -> (u64, f64) {
+    match_target! {
+        "x86_64+avx2" => {
+            use std::arch::x86_64::*;
+            chains!(rounds, __m256, f32, 8, 12, _mm256_set1_ps, _mm256_mul_ps, _mm256_add_ps, |v| {
+                let halves = _mm_add_ps(_mm256_castps256_ps128(*v), _mm256_extractf128_ps::<1>(*v));
+                let pairs = _mm_hadd_ps(halves, halves);
+                f64::from(_mm_cvtss_f32(_mm_hadd_ps(pairs, pairs)))
+            })
+        }
+        _ => (0, black_box(rounds) as f64),
+    }
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn f64x8(rounds: u64) -> (u64, f64) {
+    match_target! {
+        "x86_64+avx2" => {
+            use std::arch::x86_64::*;
+            chains!(rounds, __m256d, f64, 4, 12, _mm256_set1_pd, _mm256_mul_pd, _mm256_add_pd, |v| {
+                let halves = _mm_add_pd(_mm256_castpd256_pd128(*v), _mm256_extractf128_pd::<1>(*v));
+                _mm_cvtsd_f64(_mm_hadd_pd(halves, halves))
+            })
+        }
+        _ => (0, black_box(rounds) as f64),
+    }
+}
+
+/// The scalar solver's code is compiled for the baseline instruction set.
+#[inline(never)]
+fn f32x1(rounds: u64) -> (u64, f64) {
+    chains!(rounds, f32, f32, 1, 12, |x: f32| x, |a: f32, b: f32| a * b, |a: f32, b: f32| a + b, |&v: &f32| f64::from(
+        v
+    ))
+}

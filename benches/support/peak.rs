@@ -25,7 +25,8 @@ pub struct Peak {
 }
 
 impl Peak {
-    /// `sixteen`: the lane solver ran its 16-lane (AVX-512) kernel; else its 8-lane one.
+    /// `sixteen`: the lane solver ran its 16-lane (AVX-512) kernel; else its 8-lane one (AVX2 where the CPU has
+    /// it, else the portable copy).
     pub fn measure(sixteen: bool) -> Self {
         let (simd_f32, simd_f64) = if sixteen { (best(f32x16), best(f64x16)) } else { (best(f32x8), best(f64x8)) };
         Self { scalar_f32: best(f32x1), simd_f32, simd_f64, lanes: if sixteen { 16 } else { 8 } }
@@ -120,7 +121,18 @@ fn f32x8(rounds: u64) -> (u64, f64) {
                 f64::from(_mm_cvtss_f32(_mm_hadd_ps(pairs, pairs)))
             })
         }
-        _ => (0, black_box(rounds) as f64),
+        // The portable kernel (SSE2, NEON): arrays, few enough chains for 16 128-bit registers.
+        _ => chains!(
+            rounds,
+            [f32; 8],
+            f32,
+            8,
+            6,
+            |x| [x; 8],
+            lanewise::<f32, 8>(|a, b| a * b),
+            lanewise::<f32, 8>(|a, b| a + b),
+            |v: &[f32; 8]| v.iter().map(|&x| f64::from(x)).sum::<f64>()
+        ),
     }
 }
 
@@ -134,7 +146,17 @@ fn f64x8(rounds: u64) -> (u64, f64) {
                 _mm_cvtsd_f64(_mm_hadd_pd(halves, halves))
             })
         }
-        _ => (0, black_box(rounds) as f64),
+        _ => chains!(
+            rounds,
+            [f64; 8],
+            f64,
+            8,
+            2,
+            |x| [x; 8],
+            lanewise::<f64, 8>(|a, b| a * b),
+            lanewise::<f64, 8>(|a, b| a + b),
+            |v: &[f64; 8]| v.iter().sum::<f64>()
+        ),
     }
 }
 

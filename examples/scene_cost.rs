@@ -3,7 +3,7 @@
 //! `docs/robustness.md` (bug 1):
 //! `valgrind --tool=callgrind target/release/examples/scene_cost 60 1x1000_hair scalar`, then divide the total
 //! by the dynamic joints and substeps printed. Scenes: `100x16`, `1000x16`, `1x1000` (0.8 m rope), `1x1000_hair`
-//! (2.5 cm segments); variants: `lanes` (default), `scalar`, `colliders`
+//! (2.5 cm segments), `ragged` (the report's 200 chains of 4 to 32 joints); variants: `lanes` (default), `scalar`, `colliders`
 //! (the head sphere, shoulders and ground of the report's colliders variant, on the lane solver) and
 //! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair), `lod1` and `lod2`, `views`, `limp`
 //! (three view shapes per chain, orbiting camera). It also prints the
@@ -21,13 +21,14 @@ use scenes::{
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest|lod1|lod2|views|limp]";
+    let usage = "usage: scene_cost FRAMES 100x16|1000x16|1x1000|1x1000_hair|ragged [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest|lod1|lod2|views|limp]";
     let frames: u64 = args.first().and_then(|f| f.parse().ok()).expect(usage);
     let scene = match args.get(1).map(String::as_str) {
         Some("100x16") => Scene::uniform("100x16", 100, 16),
         Some("1000x16") => Scene::uniform("1000x16", 1000, 16),
         Some("1x1000") => Scene::uniform("1x1000", 1, 1000),
         Some("1x1000_hair") => Scene::uniform("1x1000_hair", 1, 1000).with_segment(0.025),
+        Some("ragged") => Scene::ragged("ragged", 200, 4, 32),
         _ => panic!("{usage}"),
     };
     let variant = match args.get(2).map(String::as_str) {

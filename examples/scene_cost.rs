@@ -2,11 +2,11 @@
 //! for instruction counts that do not depend on the machine's load, e.g. the linearity figures of
 //! `docs/robustness.md` (bug 1):
 //! `valgrind --tool=callgrind target/release/examples/scene_cost 60 1x1000_hair scalar`, then divide the total
-//! by the dynamic joints and substeps printed. Scenes: `100x16`, `1000x16`, `1x1000` (0.8 m rope), `1x1000_hair`
-//! (2.5 cm segments), `ragged` (the report's 200 chains of 4 to 32 joints); variants: `lanes` (default),
-//! `scalar`, `colliders` (the head sphere, shoulders and ground of the report's colliders variant, on the lane solver) and
-//! `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair), `lod1` and `lod2`, `views`, `limp`
-//! (three view shapes per chain, orbiting camera). It also prints the
+//! by the dynamic joints and substeps printed. Scenes: `100x16`, `1000x16`, `1x1000` (0.8 m rope),
+//! `1x1000_hair` (2.5 cm segments), `ragged` (the report's 200 chains of 4 to 32 joints); variants: `lanes`
+//! (default), `scalar`, `colliders` (the head sphere, shoulders and ground of the report's colliders variant, on
+//! the lane solver) and `colliders_scalar`, `asleep` and `awake_at_rest` (the sleeping-chain skip's pair), `lod1`
+//! and `lod2`, `views` (three view shapes per chain, orbiting camera), `limp` (stiffness 0). It also prints the
 //! engine's state hash and the contact pairs tested, so that two builds can be checked to compute the same
 //! bits on a scene, and last the mean time of a frame, for `tools/ab.sh` (interleaved timing of two builds:
 //! `tools/ab.sh OLD NEW 20 200 100x16 views`).

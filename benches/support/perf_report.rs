@@ -640,9 +640,9 @@ impl Report {
         md.push_str(
             "\nInterleaved (the ratio the target uses), each ratio pooled over 8 pairs of engines made afresh, with the \
              method's A/A control. Where the allocator puts two engines' arrays shifts one of them by a few percent \
-             for its whole life (the A/A control's pairs, one at a time, measured from 0.992 to 1.042), so a single \
-             pair's ratio carries that shift: with one pair, this report measured the C ABI at +6.0 % and, run again \
-             at once, at -4.0 %.\n\n\
+             for its whole life, so a single pair's ratio carries that shift: when this method replaced the single \
+             pair (stop 21), the A/A control's pairs taken one at a time measured from 0.992 to 1.042, and with one \
+             pair one report measured the C ABI at +6.0 % and a rerun at once -4.0 %.\n\n\
              | what | A | B | A us/frame | B us/frame | B / A | rounds |\n\
              |---|---|---|---|---|---|---|\n",
         );

@@ -904,14 +904,7 @@ impl Engine {
     /// C ABI's `kdw_transform`): one pass over every chain's joints, with no call per joint to a callback that
     /// the compiler cannot inline.
     pub fn read_world_as<T>(&self, out: &mut [T], convert: impl Fn(Transform) -> T) -> Result<usize> {
-        self.check_capacity(out.len())?;
-        let mut written = 0;
-        for chain in self.chains_in_order() {
-            let joints = chain.joint_count();
-            chain.write_world_as(&mut out[written..written + joints], &convert);
-            written += joints;
-        }
-        Ok(written)
+        self.fill_by_chain(out, |chain, slots| chain.write_world_as(slots, &convert))
     }
 
     /// Local rotations (see [`for_each_local_rotation`](Self::for_each_local_rotation)) into `out`.
@@ -922,13 +915,21 @@ impl Engine {
     /// [`read_local_rotations`](Self::read_local_rotations) into a host's own quaternion type, each converted by
     /// `convert` (see [`read_world_as`](Self::read_world_as)).
     pub fn read_local_rotations_as<T>(&self, out: &mut [T], convert: impl Fn(Quat) -> T) -> Result<usize> {
+        self.fill_by_chain(out, |chain, slots| {
+            for (slot, rotation) in slots.iter_mut().zip(chain.local_rotations()) {
+                *slot = convert(rotation);
+            }
+        })
+    }
+
+    /// Checks that `out` holds every joint, then hands `fill` each chain, in creation order, with its joints'
+    /// slots of `out`. Returns how many were written.
+    fn fill_by_chain<T>(&self, out: &mut [T], mut fill: impl FnMut(&Chain, &mut [T])) -> Result<usize> {
         self.check_capacity(out.len())?;
         let mut written = 0;
         for chain in self.chains_in_order() {
             let joints = chain.joint_count();
-            for (slot, rotation) in out[written..written + joints].iter_mut().zip(chain.local_rotations()) {
-                *slot = convert(rotation);
-            }
+            fill(chain, &mut out[written..written + joints]);
             written += joints;
         }
         Ok(written)

@@ -7,11 +7,11 @@
 //! Same operations as the scalar functions, per lane (glam's scalar formulas, as everywhere in the lanes):
 //! the results agree with the scalar solver's up to rounding and do not depend on the lane or the kernel.
 
-use glam::{Quat, Vec3};
+use glam::{DQuat, Quat, Vec3};
 
 use super::group::LaneGroup;
 use super::simd::{F, Mask, Q, V3};
-use crate::core::math::shortest_arc;
+use crate::core::math::swing_to;
 
 /// `Chain::capture_local` on every lane: the pose after substep `s` relative to that substep's anchor becomes
 /// the newest, the one before it the previous.
@@ -72,53 +72,46 @@ fn swing<const L: usize>(q: Q<L>, axis: V3<L>, direction: V3<L>) -> Q<L> {
     let arc = Q { x: turn.x, y: turn.y, z: turn.z, w: F::splat(1.0) + cos };
     let swung = arc.mul(q).normalize();
     let folded = cos.gt(F::splat(0.0)).not();
-    if folded.any() { swing_folded(q, current, direction, folded, swung) } else { swung }
+    if folded.any() { swing_folded(q, axis, current, direction, folded, swung) } else { swung }
 }
 
 /// The lanes of `folded` (a bone more than a right angle from its segment: common on limp chains, whose
-/// particles' orientations do not follow their segments) swung with `math::shortest_arc`'s arc: glam's
-/// `DQuat::from_rotation_arc` of the normalised vectors, its double-precision operations in its order, lane
-/// by lane in a loop the compiler vectorises (it was `math::swing_to` called lane by lane: 14 % of the limp
-/// 1000 x 16 frame, `perf record` of `scene_cost 300 1000x16 limp`). The arc's 180-degree singularity, where
-/// glam picks an axis, takes `math::swing_to` itself (rare).
+/// particles' orientations do not follow their segments) swung with `math::shortest_arc`'s arc: the body of
+/// glam's `DQuat::from_rotation_arc` of the normalised vectors, lane by lane in a loop the compiler vectorises
+/// (it was `math::swing_to` called lane by lane: 14 % of the limp 1000 x 16 frame, `perf record` of
+/// `scene_cost 300 1000x16 limp`). The arc's 180-degree singularity, where glam picks an axis, takes
+/// `math::swing_to` itself (rare).
 #[inline(always)]
-fn swing_folded<const L: usize>(q: Q<L>, current: V3<L>, direction: V3<L>, folded: Mask<L>, swung: Q<L>) -> Q<L> {
+fn swing_folded<const L: usize>(
+    q: Q<L>,
+    axis: V3<L>,
+    current: V3<L>,
+    direction: V3<L>,
+    folded: Mask<L>,
+    swung: Q<L>,
+) -> Q<L> {
     const ONE_MINUS_EPS: f64 = 1.0 - 2.0 * f64::EPSILON;
     let mut arcs = Q::IDENTITY;
     let mut singular = [false; L];
     for lane in 0..L {
-        let from = normalize(current.get(lane).map(f64::from));
-        let to = normalize(direction.get(lane).map(f64::from));
-        let dot = from[0] * to[0] + from[1] * to[1] + from[2] * to[2];
-        let c =
-            [from[1] * to[2] - to[1] * from[2], from[2] * to[0] - to[2] * from[0], from[0] * to[1] - to[0] * from[1]];
-        let w = 1.0 + dot;
-        let inverse_length = 1.0 / (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + w * w).sqrt();
-        let arc = [c[0] * inverse_length, c[1] * inverse_length, c[2] * inverse_length, w * inverse_length];
-        let arc = if dot > ONE_MINUS_EPS { [0.0, 0.0, 0.0, 1.0] } else { arc };
+        let from = Vec3::from_array(current.get(lane)).as_dvec3().normalize();
+        let to = Vec3::from_array(direction.get(lane)).as_dvec3().normalize();
+        let dot = from.dot(to);
+        let c = from.cross(to);
+        let arc = DQuat::from_xyzw(c.x, c.y, c.z, 1.0 + dot).normalize().as_quat();
         singular[lane] = dot < -ONE_MINUS_EPS;
-        arcs.set(lane, arc.map(|x| x as f32));
+        arcs.set(lane, if dot > ONE_MINUS_EPS { [0.0, 0.0, 0.0, 1.0] } else { arc.to_array() });
     }
     let mut swung = Q::select(folded, arcs.mul(q).normalize(), swung);
     for lane in (0..L).filter(|&lane| folded.0[lane] && singular[lane]) {
-        swung.set(lane, swing_singular(q.get(lane), current.get(lane), direction.get(lane)));
+        let exact = swing_to(
+            Quat::from_array(q.get(lane)),
+            Vec3::from_array(axis.get(lane)),
+            Vec3::from_array(direction.get(lane)),
+        );
+        swung.set(lane, exact.to_array());
     }
     swung
-}
-
-/// `DVec3::normalize`.
-#[inline(always)]
-fn normalize(v: [f64; 3]) -> [f64; 3] {
-    let inverse_length = 1.0 / (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|x| x * inverse_length)
-}
-
-/// `math::swing_to` of one lane at the arc's 180-degree singularity.
-#[cold]
-#[inline(never)]
-fn swing_singular(q: [f32; 4], current: [f32; 3], direction: [f32; 3]) -> [f32; 4] {
-    let arc = shortest_arc(Vec3::from_array(current), Vec3::from_array(direction));
-    (arc * Quat::from_array(q)).normalize().to_array()
 }
 
 #[cfg(test)]

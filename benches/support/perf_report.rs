@@ -76,6 +76,9 @@ pub struct PairedRatio {
     pub b_seconds: f64,
     pub ratio: f64,
     pub rounds: usize,
+    /// For a ratio pooled over pairs of runs ([`pooled_paired_ratio`]): the smallest and largest of the pairs'
+    /// own medians.
+    pub pair_range: Option<(f64, f64)>,
 }
 
 /// Interleaves blocks of frames of `a` and `b` for `rounds` rounds; each block lasts about `block`.
@@ -103,6 +106,7 @@ pub fn pooled_paired_ratio(
     block: Duration,
 ) -> PairedRatio {
     let mut pooled = RoundTimes::default();
+    let mut pair_range = (f64::INFINITY, f64::NEG_INFINITY);
     for pair in 0..pairs {
         let (mut a, mut b) = if pair % 2 == 0 {
             let a = make_a();
@@ -112,12 +116,14 @@ pub fn pooled_paired_ratio(
             (make_a(), b)
         };
         let times = paired_rounds(&mut *a, &mut *b, rounds.div_ceil(pairs), block);
+        let own = median(times.ratios());
+        pair_range = (pair_range.0.min(own), pair_range.1.max(own));
         pooled.a.extend(times.a);
         pooled.b.extend(times.b);
         // Each pair's runs are dropped before the next pair's are made.
         drop((a, b));
     }
-    pooled.ratio(what, a_name, b_name)
+    PairedRatio { pair_range: Some(pair_range), ..pooled.ratio(what, a_name, b_name) }
 }
 
 /// Seconds per frame of each round's block of A and of B.
@@ -128,8 +134,13 @@ struct RoundTimes {
 }
 
 impl RoundTimes {
+    /// B / A, round by round.
+    fn ratios(&self) -> Vec<f64> {
+        self.a.iter().zip(&self.b).map(|(x, y)| y / x).collect()
+    }
+
     fn ratio(self, what: &str, a_name: &str, b_name: &str) -> PairedRatio {
-        let ratios = self.a.iter().zip(&self.b).map(|(x, y)| y / x).collect::<Vec<_>>();
+        let ratios = self.ratios();
         PairedRatio {
             what: what.into(),
             a: a_name.into(),
@@ -138,6 +149,7 @@ impl RoundTimes {
             a_seconds: median(self.a),
             b_seconds: median(self.b),
             ratio: median(ratios),
+            pair_range: None,
         }
     }
 }
@@ -640,14 +652,25 @@ impl Report {
         md.push_str(
             "\nInterleaved (the ratio the target uses), each ratio pooled over 8 pairs of engines made afresh, with the \
              method's A/A control. Where the allocator puts two engines' arrays shifts one of them by a few percent \
-             for its whole life, so a single pair's ratio carries that shift: when this method replaced the single \
-             pair (stop 21), the A/A control's pairs taken one at a time measured from 0.992 to 1.042, and with one \
-             pair one report measured the C ABI at +6.0 % and a rerun at once -4.0 %.\n\n\
-             | what | A | B | A us/frame | B us/frame | B / A | rounds |\n\
-             |---|---|---|---|---|---|---|\n",
+             for its whole life, so a single pair's ratio carries that shift (with one pair, the report of commit \
+             b9b8ccf measured the C ABI at +6.0 % and +5.9 %); *pairs* gives the range of the pairs' own \
+             medians.\n\n\
+             | what | A | B | A us/frame | B us/frame | B / A | rounds | pairs |\n\
+             |---|---|---|---|---|---|---|---|\n",
         );
         for p in self.paired.iter().filter(|p| p.what.starts_with("C ABI")) {
-            paired_row(md, p);
+            let pairs = p.pair_range.map_or("-".into(), |(low, high)| format!("{low:.3} to {high:.3}"));
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {:.3} | {} | {pairs} |",
+                p.what,
+                p.a,
+                p.b,
+                micros(Some(p.a_seconds)),
+                micros(Some(p.b_seconds)),
+                p.ratio,
+                p.rounds
+            );
         }
         md.push('\n');
     }

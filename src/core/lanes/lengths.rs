@@ -95,21 +95,30 @@ pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, passe
     solved
 }
 
-/// `inextensible::error_after_step` on every lane, from `g.step`.
+/// `inextensible::error_after_step` on every lane, from `g.step`. Lane by lane within each bond, as the passes:
+/// written with whole-group operations, the compiler vectorised the loop over the bonds instead (two bonds per
+/// 128-bit register, every value gathered), and this function took more instructions than both passes.
 #[inline(always)]
 fn error_after_step<const L: usize>(g: &LaneGroup<L>, m: usize) -> D<L> {
-    let d = &g.start_bonds[..m];
-    let mut worst = D::splat(0.0);
-    let mut below = DV3::ZERO;
+    let (d, step, inv_l2) = (&g.start_bonds[..m], &g.step[..m], &g.inverse_length_squared[..m]);
+    let mut worst = [0.0; L];
+    let mut below = DV3::<L>::ZERO;
     for k in 0..m {
-        let own = d[k].scale(g.step[k]);
-        let above = if k + 1 < m { own - d[k + 1].scale(g.step[k + 1]) } else { own };
-        let error = (above - below).length_squared() * g.inverse_length_squared[k];
-        // As the scalar code: a NaN error is ignored here (its lane's step was not finite: not active).
-        worst = D::select(error.gt(worst), error, worst);
-        below = above;
+        let upper = (k + 1).min(m - 1);
+        let end = k + 1 == m;
+        let (own, own_step, next, next_step, inv) = (&d[k], &step[k], &d[upper], &step[upper], &inv_l2[k]);
+        for lane in 0..L {
+            let pulled = scale(own.get(lane), own_step.0[lane]);
+            let pushed = scale(next.get(lane), next_step.0[lane]);
+            let above = if end { pulled } else { sub(pulled, pushed) };
+            let e = sub(above, below.get(lane));
+            let error = dot(e, e) * inv.0[lane];
+            // As the scalar code: a NaN error is ignored here (its lane's step was not finite: not active).
+            worst[lane] = if error > worst[lane] { error } else { worst[lane] };
+            below.set(lane, above);
+        }
     }
-    worst
+    D(worst)
 }
 
 /// The positions under the multipliers on the lanes of `lanes`, as [`corrected_pass`] computes them.

@@ -108,9 +108,7 @@ fn error_after_step<const L: usize>(g: &LaneGroup<L>, m: usize) -> D<L> {
         let end = k + 1 == m;
         let (own, own_step, next, next_step, inv) = (&d[k], &step[k], &d[upper], &step[upper], &inv_l2[k]);
         for lane in 0..L {
-            let pulled = scale(own.get(lane), own_step.0[lane]);
-            let pushed = scale(next.get(lane), next_step.0[lane]);
-            let above = if end { pulled } else { sub(pulled, pushed) };
+            let above = bond_shift(own.get(lane), own_step.0[lane], next.get(lane), next_step.0[lane], end);
             let e = sub(above, below.get(lane));
             let error = dot(e, e) * inv.0[lane];
             // As the scalar code: a NaN error is ignored here (its lane's step was not finite: not active).
@@ -210,9 +208,7 @@ pub fn corrected_pass<const L: usize>(
         let (start, moved_tip) = (&below[k], &mut at[0]);
         let (c_row, d_row) = (&mut c_prime[k], &mut d_prime[k]);
         for lane in 0..L {
-            let pulled = scale(bond.own.get(lane), own_mu.0[lane]);
-            let pushed = scale(bond.upper.get(lane), upper_mu.0[lane]);
-            let shift = if end { pulled } else { sub(pulled, pushed) };
+            let shift = bond_shift(bond.own.get(lane), own_mu.0[lane], bond.upper.get(lane), upper_mu.0[lane], end);
             let moved = add(tip.get(lane), shift);
             moved_tip.set(lane, moved);
             pass.row(lane, sub(moved, start.get(lane)), &bond, c_row, d_row);
@@ -300,6 +296,14 @@ impl<const L: usize> ForwardPass<L> {
     fn pivots_usable(&self) -> Mask<L> {
         self.scale.gt(D::splat(0.0)).and(self.smallest_pivot.gt(self.scale * MIN_PIVOT))
     }
+}
+
+/// How far a bond's tip moves under the multipliers `own` (its bond's) and `upper` (the next bond's, none at the
+/// last bond): pulled along its own start bond, pushed back along the next one (`inextensible::shift`).
+#[inline(always)]
+fn bond_shift(own_bond: DVec, own: f64, upper_bond: DVec, upper: f64, last: bool) -> DVec {
+    let pulled = scale(own_bond, own);
+    if last { pulled } else { sub(pulled, scale(upper_bond, upper)) }
 }
 
 #[inline(always)]

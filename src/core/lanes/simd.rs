@@ -100,8 +100,8 @@ macro_rules! lanewise {
             /// `if m { a } else { b }`, lane by lane, as a bitwise blend (the same bits). Written as a plain
             /// conditional, `x = select(m, y, x)` on a buffer compiles to masked stores (`vmaskmovpd`), which AMD's
             /// Zen cores run as many micro-operations: the mask updates of the direct solve's multipliers and
-            /// positions alone cost 12% of a 1000 x 16 frame there (`tools/ab.sh`, `scene_cost 30 1000x16`, 12
-            /// rounds: 0.879).
+            /// positions alone cost 12% of a 1000 x 16 frame there (`tools/ab.sh OLD NEW 12 30 1000x16` with
+            /// `scene_cost` built before and after commit 2fb4659: 0.879).
             #[inline(always)]
             pub fn select(m: Mask<L>, a: Self, b: Self) -> Self {
                 let mut r = b.0;

@@ -12,6 +12,7 @@
 //! - [`buffers`]: reusable buffers sized before the steps that fill them
 //! - [`arena`], [`chain`], [`engine`]: objects, ids and the stepping loop (3.5, 3.6, 3.9)
 
+pub(crate) mod arcs;
 pub mod arena;
 pub mod batch;
 pub mod blend;

@@ -4,6 +4,7 @@
 
 use glam::{DVec3, Mat3A, Quat, Vec3, Vec3A};
 
+use super::arcs::ArcColumns;
 use super::collision::{ContactInput, SegmentBounds, collide, pre_stabilise};
 use super::inextensible::{self, ConstraintScratch, SolveMemory};
 use super::math::{Transform, align_hemisphere, exp_small, log_small, nlerp_shorter};
@@ -155,6 +156,8 @@ pub struct RodScratch {
     qp: Vec<Quat>,
     /// Positions of the chain carried over to a new rest shape (momentum suppression).
     p_old: Vec<DVec3>,
+    /// The momentum suppression's segment arcs.
+    arcs: ArcColumns,
     constraints: ConstraintScratch,
     bounds: SegmentBounds,
     /// The contact normal of each particle that slides on a collider in the contact rounds' lengths solves
@@ -171,6 +174,7 @@ impl RodScratch {
             self.p_old.resize(n, DVec3::ZERO);
             self.normals.resize(n, Vec3::ZERO);
         }
+        self.arcs.reserve(n.saturating_sub(1));
         self.constraints.reserve(n.saturating_sub(1));
         self.bounds.reserve(n.saturating_sub(1));
     }
@@ -186,7 +190,7 @@ pub fn substep(
     let n = state.x.len();
     scratch.reserve(n);
     let h = input.h;
-    let RodScratch { p, qp, p_old, constraints, bounds, normals } = scratch;
+    let RodScratch { p, qp, p_old, constraints, bounds, normals, .. } = scratch;
     let settled = input.contact_settled;
     if let Some(contacts) = &input.contacts {
         let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
@@ -304,18 +308,20 @@ pub fn carry_to_new_rest(
 ) {
     let n = state.x.len();
     scratch.reserve(n);
-    let target = &mut scratch.p_old[..n];
-    target[0] = state.x[0];
+    let RodScratch { p_old: target, arcs, .. } = scratch;
+    // Each segment's deformation: the shortest arc from its old rest direction to its current one, all
+    // segments' arcs at once (`ArcColumns`). A segment of no length has no direction to carry: its arc is the
+    // identity, and it keeps its new rest direction.
     for k in 0..n - 1 {
         let old_segment = anchor.rotation * (old.positions[k + 1] - old.positions[k]);
         let current = (state.x[k + 1] - state.x[k]).as_vec3();
-        // A segment of no length has no direction to carry: it keeps its new rest direction.
-        let deformation = match (super::math::direction(old_segment), super::math::direction(current)) {
-            (Some(from), Some(to)) => super::math::shortest_arc(from, to),
-            _ => Quat::IDENTITY,
-        };
+        arcs.set(k, old_segment, current);
+    }
+    arcs.compute(n - 1);
+    target[0] = state.x[0];
+    for k in 0..n - 1 {
         let new_segment = anchor.rotation * (new.positions[k + 1] - new.positions[k]);
-        target[k + 1] = target[k] + (deformation * new_segment).as_dvec3();
+        target[k + 1] = target[k] + (arcs.arc(k) * new_segment).as_dvec3();
     }
     let share_f64 = share as f64;
     for j in 1..n {

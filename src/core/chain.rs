@@ -9,7 +9,7 @@ use super::buffers::reserve_total;
 use super::error::{Error, Result};
 use super::math::{Transform, direction, nlerp_shorter, swing_to};
 use super::params::{ChainParams, EngineSettings, SLEEP_DELAY};
-use super::rod::{CONTACT_SETTLED, RestGroups, RodState};
+use super::rod::{CONTACT_SETTLED, ChainConstants, RestGroups, RodState};
 use super::shape::{EncodedShape, Shape, ShapeFrame};
 use super::weights::{ViewWeighting, blend_weights};
 
@@ -85,6 +85,18 @@ pub struct Chain {
     asleep_anchor: Transform,
     /// Simulated seconds the chain has been still (towards falling asleep).
     pub(crate) still_time: f32,
+    /// The last step's solver constants and what they were computed from (see [`constants`](Self::constants)).
+    constants: Option<CachedConstants>,
+}
+
+/// [`ChainConstants`] with their inputs.
+#[derive(Clone, Copy)]
+struct CachedConstants {
+    params: ChainParams,
+    settings: EngineSettings,
+    h: f32,
+    iterations: u32,
+    constants: ChainConstants,
 }
 
 impl Chain {
@@ -131,6 +143,7 @@ impl Chain {
             asleep_world: Vec::with_capacity(n),
             asleep_anchor: Transform::IDENTITY,
             still_time: 0.0,
+            constants: None,
         };
         chain.update_rest(None);
         chain.rest_used.clone_from(&chain.rest);
@@ -283,6 +296,29 @@ impl Chain {
         self.frame = frame;
         self.shapes_dirty = true;
         Ok(())
+    }
+
+    /// The solver constants of a step of substep `h` and `iterations` iterations under `settings`: those of the
+    /// last step unless an input changed. Computing them takes a few transcendental functions per chain
+    /// (`libm`'s `expm1f`, `logf` and `powf` were 2 to 3 % of a 100 x 16 frame at `EngineSettings::lod` 2, `perf
+    /// record` of `scene_cost 1500 100x16 lod2`), for inputs that a scene rarely changes.
+    pub(crate) fn constants(&mut self, settings: &EngineSettings, h: f32, iterations: u32) -> ChainConstants {
+        let params = self.params;
+        match self.constants {
+            Some(cached)
+                if cached.params == params
+                    && cached.settings == *settings
+                    && cached.h == h
+                    && cached.iterations == iterations =>
+            {
+                cached.constants
+            }
+            _ => {
+                let constants = ChainConstants::new(&params, settings, h, iterations);
+                self.constants = Some(CachedConstants { params, settings: *settings, h, iterations, constants });
+                constants
+            }
+        }
     }
 
     /// Re-blends the rest shape for view direction `view` when it or the shapes changed. A changed rest
@@ -500,6 +536,34 @@ mod tests {
     use glam::{Quat, Vec3};
 
     use super::*;
+
+    #[test]
+    fn cached_constants_follow_every_input() {
+        let joints: Vec<Transform> =
+            (0..4).map(|i| Transform::new(Vec3::new(0.0, 0.1 * i as f32, 0.0), Quat::IDENTITY)).collect();
+        let mut chain = Chain::new(ChainParams::default(), &joints).unwrap();
+        let bits = |c: ChainConstants| {
+            [c.alpha_per_iteration, c.velocity_decay, c.gravity.x, c.gravity.y, c.gravity.z, c.orientation_weight]
+                .map(f32::to_bits)
+        };
+        let mut check = |chain: &mut Chain, settings: EngineSettings, h: f32, iterations: u32| {
+            let expected = ChainConstants::new(&chain.params, &settings, h, iterations);
+            assert_eq!(bits(chain.constants(&settings, h, iterations)), bits(expected));
+        };
+        let settings = EngineSettings::default();
+        check(&mut chain, settings, 1.0 / 240.0, 2);
+        check(&mut chain, settings, 1.0 / 240.0, 2);
+        check(&mut chain, settings, 1.0 / 120.0, 2);
+        check(&mut chain, settings, 1.0 / 120.0, 1);
+        check(&mut chain, EngineSettings { gravity: Vec3::new(0.0, -3.0, 0.0), ..settings }, 1.0 / 120.0, 1);
+        check(&mut chain, EngineSettings { scale: 2.0, ..settings }, 1.0 / 120.0, 1);
+        chain.params.stiffness = 0.25;
+        check(&mut chain, settings, 1.0 / 120.0, 1);
+        chain.params.damping = 7.0;
+        check(&mut chain, settings, 1.0 / 120.0, 1);
+        chain.params.radius = 0.05;
+        check(&mut chain, settings, 1.0 / 120.0, 1);
+    }
 
     fn collect(chain: &Chain) -> Vec<Transform> {
         let mut out = Vec::new();

@@ -734,7 +734,7 @@ impl Engine {
             }
 
             let params = chain.params;
-            let constants = ChainConstants::new(&params, &settings, h as f32, iterations);
+            let constants = chain.constants(&settings, h as f32, iterations);
             if substeps > 0 {
                 if chain.rest_changed {
                     let share = params.momentum_suppression * params.alpha_per_substep(h as f32);

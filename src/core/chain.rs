@@ -546,7 +546,7 @@ mod tests {
             [c.alpha_per_iteration, c.velocity_decay, c.gravity.x, c.gravity.y, c.gravity.z, c.orientation_weight]
                 .map(f32::to_bits)
         };
-        let mut check = |chain: &mut Chain, settings: EngineSettings, h: f32, iterations: u32| {
+        let check = |chain: &mut Chain, settings: EngineSettings, h: f32, iterations: u32| {
             let expected = ChainConstants::new(&chain.params, &settings, h, iterations);
             assert_eq!(bits(chain.constants(&settings, h, iterations)), bits(expected));
         };

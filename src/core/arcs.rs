@@ -1,9 +1,10 @@
 //! The shortest arcs between many pairs of vectors at once: `math::shortest_arc` of their directions, for
 //! every segment of a chain in one loop that the compiler vectorises. One arc is three double-precision square
 //! roots and five divisions in a row; called segment by segment (as the momentum suppression did), the
-//! arcs of a chain ran one after the other, each waiting on its own divisions (`rod::carry_to_new_rest` was 10 %
-//! of the 1000 x 16 *views* frame: `perf record` of `scene_cost 100 1000x16 views` at a703489). Written over
-//! columns of numbers with no branch in the loop body, four segments share each double-precision instruction.
+//! arcs of a chain ran one after the other, each waiting on its own divisions (`rod::carry_to_new_rest` was 9 %
+//! of the 1000 x 16 *views* frame: `perf record -F 5000` of `scene_cost 100 1000x16 views` at a703489). Written over
+//! columns of numbers with no branch in the loop body, four segments share each double-precision instruction
+//! (two in the baseline SSE2 copy).
 //!
 //! The arithmetic is `math::direction`'s and glam's `DQuat::from_rotation_arc`'s, operation for operation
 //! (the same glam calls, their branches turned into selects), so every arc has the bits the per-segment calls
@@ -17,8 +18,8 @@ use super::math::{direction, shortest_arc};
 /// Columns of vectors in and arcs out, one entry per pair.
 #[derive(Default)]
 pub struct ArcColumns {
-    pub from: [Vec<f32>; 3],
-    pub to: [Vec<f32>; 3],
+    from: [Vec<f32>; 3],
+    to: [Vec<f32>; 3],
     arcs: [Vec<f32>; 4],
     /// Pairs whose directions are opposite: their arc's axis is glam's choice, computed apart (rare).
     opposite: Vec<bool>,

@@ -38,16 +38,22 @@ impl ArcColumns {
         }
     }
 
-    /// Pair `k`'s vectors.
+    /// Sets the first `n` pairs, pair `k` to `pair(k)`. One loop over columns cut to `n`, so that the compiler
+    /// drops the bounds checks (set one at a time, each pair's six stores were checked).
     #[inline]
-    pub fn set(&mut self, k: usize, from: Vec3, to: Vec3) {
-        for axis in 0..3 {
-            self.from[axis][k] = from[axis];
-            self.to[axis][k] = to[axis];
+    pub fn set_all(&mut self, n: usize, mut pair: impl FnMut(usize) -> (Vec3, Vec3)) {
+        let [fx, fy, fz] = &mut self.from;
+        let [tx, ty, tz] = &mut self.to;
+        let (fx, fy, fz, tx, ty, tz) =
+            (&mut fx[..n], &mut fy[..n], &mut fz[..n], &mut tx[..n], &mut ty[..n], &mut tz[..n]);
+        for k in 0..n {
+            let (from, to) = pair(k);
+            (fx[k], fy[k], fz[k]) = (from.x, from.y, from.z);
+            (tx[k], ty[k], tz[k]) = (to.x, to.y, to.z);
         }
     }
 
-    /// The arcs of the first `n` pairs: [`arc`](Self::arc) reads them.
+    /// The arcs of the first `n` pairs: [`arcs`](Self::arcs) reads them.
     pub fn compute(&mut self, n: usize) {
         let [fx, fy, fz] = &self.from;
         let [tx, ty, tz] = &self.to;
@@ -60,15 +66,17 @@ impl ArcColumns {
         );
     }
 
-    /// Pair `k`'s arc: `shortest_arc(direction(from), direction(to))`, the identity where either vector has no
-    /// direction (`math::direction`'s `None`).
+    /// The arcs of the first `n` pairs, in order: pair `k`'s is `shortest_arc(direction(from), direction(to))`,
+    /// the identity where either vector has no direction (`math::direction`'s `None`).
     #[inline]
-    pub fn arc(&self, k: usize) -> Quat {
-        if self.opposite[k] {
-            return self.exact(k);
-        }
+    pub fn arcs(&self, n: usize) -> impl Iterator<Item = Quat> + '_ {
         let [x, y, z, w] = &self.arcs;
-        Quat::from_xyzw(x[k], y[k], z[k], w[k])
+        let columns = x[..n].iter().zip(&y[..n]).zip(&z[..n]).zip(&w[..n]).zip(&self.opposite[..n]);
+        columns.enumerate().map(
+            |(k, ((((&x, &y), &z), &w), &opposite))| {
+                if opposite { self.exact(k) } else { Quat::from_xyzw(x, y, z, w) }
+            },
+        )
     }
 
     #[cold]
@@ -142,16 +150,13 @@ mod tests {
         }
         let mut columns = ArcColumns::default();
         columns.reserve(pairs.len());
-        for (k, &(from, to)) in pairs.iter().enumerate() {
-            columns.set(k, from, to);
-        }
+        columns.set_all(pairs.len(), |k| pairs[k]);
         columns.compute(pairs.len());
-        for (k, &(from, to)) in pairs.iter().enumerate() {
+        for (k, (&(from, to), got)) in pairs.iter().zip(columns.arcs(pairs.len())).enumerate() {
             let expected = match (direction(from), direction(to)) {
                 (Some(from), Some(to)) => shortest_arc(from, to),
                 _ => Quat::IDENTITY,
             };
-            let got = columns.arc(k);
             assert_eq!(
                 got.to_array().map(f32::to_bits),
                 expected.to_array().map(f32::to_bits),

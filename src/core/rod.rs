@@ -309,26 +309,28 @@ pub fn carry_to_new_rest(
     let n = state.x.len();
     scratch.reserve(n);
     let RodScratch { p_old: target, arcs, .. } = scratch;
+    // Every array cut to `n` up front, so that the compiler drops the bounds checks of the loops below.
+    let (old_positions, new_positions) = (&old.positions[..n], &new.positions[..n]);
+    let (old_orientations, new_orientations) = (&old.orientations[..n], &new.orientations[..n]);
+    let (x, q, target) = (&mut state.x[..n], &mut state.q[..n], &mut target[..n]);
     // Each segment's deformation: the shortest arc from its old rest direction to its current one, all
     // segments' arcs at once (`ArcColumns`). A segment of no length has no direction to carry: its arc is the
     // identity, and it keeps its new rest direction.
-    for k in 0..n - 1 {
-        let old_segment = anchor.rotation * (old.positions[k + 1] - old.positions[k]);
-        let current = (state.x[k + 1] - state.x[k]).as_vec3();
-        arcs.set(k, old_segment, current);
-    }
+    arcs.set_all(n - 1, |k| {
+        let old_segment = anchor.rotation * (old_positions[k + 1] - old_positions[k]);
+        (old_segment, (x[k + 1] - x[k]).as_vec3())
+    });
     arcs.compute(n - 1);
-    target[0] = state.x[0];
-    for k in 0..n - 1 {
-        let new_segment = anchor.rotation * (new.positions[k + 1] - new.positions[k]);
-        target[k + 1] = target[k] + (arcs.arc(k) * new_segment).as_dvec3();
+    target[0] = x[0];
+    for (k, arc) in arcs.arcs(n - 1).enumerate() {
+        let new_segment = anchor.rotation * (new_positions[k + 1] - new_positions[k]);
+        target[k + 1] = target[k] + (arc * new_segment).as_dvec3();
     }
     let share_f64 = share as f64;
     for j in 1..n {
-        let x = state.x[j];
-        state.x[j] = x + (target[j] - x) * share_f64;
-        let carried = (state.q[j] * old.orientations[j].inverse() * new.orientations[j]).normalize();
-        state.q[j] = nlerp_shorter(state.q[j], carried, share);
+        x[j] = x[j] + (target[j] - x[j]) * share_f64;
+        let carried = (q[j] * old_orientations[j].inverse() * new_orientations[j]).normalize();
+        q[j] = nlerp_shorter(q[j], carried, share);
     }
 }
 

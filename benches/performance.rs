@@ -567,7 +567,7 @@ fn targets(report: &Report, bound: &Bound) -> Vec<Target> {
         "1000 x 16 within 3x of the compute / memory bound (the lower bound section)",
         over_bound.map_or("not run".into(), |r| {
             format!(
-                "{r:.1}x the bound of {:.1} ns/joint/substep (measured peaks, operations counted)",
+                "{r:.1}x the bound of {:.1} ns/joint/substep (operations counted, at the measured peaks of the multipliers and adders and of the divider)",
                 bound.lanes() * 1e9
             )
         }),

@@ -1,5 +1,7 @@
 //! The arithmetic peak of one core, measured rather than assumed: how many lane operations per second it
-//! runs when nothing but independent multiplies and adds are in flight. The kernel's determinism policy
+//! runs when nothing but independent multiplies and adds are in flight, and when nothing but independent
+//! divisions, or square roots, are (they take a divider that accepts a new operation only every few cycles,
+//! where the multipliers and adders accept two per cycle). The kernel's determinism policy
 //! (`src/core/lanes/mod.rs`) rules out fused multiply-adds, so neither are they used here: the peak is the
 //! one the code as written could reach. Ratios of the rod's operation counts to these rates give the compute
 //! lines of the report's lower bound.
@@ -22,6 +24,18 @@ pub struct Peak {
     pub simd_f32: f64,
     pub simd_f64: f64,
     pub lanes: usize,
+    /// Divisions and square roots, one lane at a time and `lanes` at once.
+    pub scalar_f32_divider: Divider,
+    pub scalar_f64_divider: Divider,
+    pub simd_f32_divider: Divider,
+    pub simd_f64_divider: Divider,
+}
+
+/// Division and square root rates (lane operations per second).
+#[derive(Clone, Copy, Debug)]
+pub struct Divider {
+    pub division: f64,
+    pub root: f64,
 }
 
 impl Peak {
@@ -29,16 +43,41 @@ impl Peak {
     /// it, else the portable copy).
     pub fn measure(sixteen: bool) -> Self {
         let (simd_f32, simd_f64) = if sixteen { (best(f32x16), best(f64x16)) } else { (best(f32x8), best(f64x8)) };
-        Self { scalar_f32: best(f32x1), simd_f32, simd_f64, lanes: if sixteen { 16 } else { 8 } }
+        let divider = |division: fn(u64) -> (u64, f64), root: fn(u64) -> (u64, f64)| Divider {
+            division: best_of(division, DIVIDER_ROUNDS),
+            root: best_of(root, DIVIDER_ROUNDS),
+        };
+        let (simd_f32_divider, simd_f64_divider) = if sixteen {
+            (divider(div_f32x16, sqrt_f32x16), divider(div_f64x16, sqrt_f64x16))
+        } else {
+            (divider(div_f32x8, sqrt_f32x8), divider(div_f64x8, sqrt_f64x8))
+        };
+        Self {
+            scalar_f32: best(f32x1),
+            simd_f32,
+            simd_f64,
+            lanes: if sixteen { 16 } else { 8 },
+            scalar_f32_divider: divider(div_f32x1, sqrt_f32x1),
+            scalar_f64_divider: divider(div_f64x1, sqrt_f64x1),
+            simd_f32_divider,
+            simd_f64_divider,
+        }
     }
 }
 
+/// Rounds of a timed division or square root pass: those run about a tenth as fast as multiplies and adds.
+const DIVIDER_ROUNDS: u64 = ROUNDS / 8;
+
 /// The best rate of `run` over 5 passes.
 fn best(run: fn(u64) -> (u64, f64)) -> f64 {
+    best_of(run, ROUNDS)
+}
+
+fn best_of(run: fn(u64) -> (u64, f64), rounds: u64) -> f64 {
     let mut best = 0.0f64;
     for _ in 0..5 {
         let start = Instant::now();
-        let (operations, value) = run(black_box(ROUNDS));
+        let (operations, value) = run(black_box(rounds));
         black_box(value);
         best = best.max(operations as f64 / start.elapsed().as_secs_f64());
     }
@@ -166,4 +205,160 @@ fn f32x1(rounds: u64) -> (u64, f64) {
     chains!(rounds, f32, f32, 1, 12, |x: f32| x, |a: f32, b: f32| a * b, |a: f32, b: f32| a + b, |&v: &f32| f64::from(
         v
     ))
+}
+
+/// `$chains` independent accumulators of type `$vector`, each replaced every round by `$op(accumulator, factor)`
+/// (a division by a factor near 1, or a square root, which keeps the values near 1: no special values). As
+/// [`chains!`], evaluates to the lane operations run and a value that depends on every one of them.
+macro_rules! divider_chains {
+    ($rounds:expr, $vector:ty, $elem:ty, $lanes:literal, $chains:literal, $splat:expr, $op:expr, $sum:expr) => {{
+        let mut acc: [$vector; $chains] = std::array::from_fn(|k| $splat(1.0 + k as $elem));
+        acc = black_box(acc);
+        let factor = $splat(black_box(0.999_999_9));
+        for _ in 0..$rounds {
+            for a in &mut acc {
+                *a = $op(*a, factor);
+            }
+        }
+        ($rounds * $chains * $lanes, acc.iter().map($sum).sum::<f64>())
+    }};
+}
+
+/// A division, and a square root (ignoring its second argument), lane by lane.
+#[inline(always)]
+fn lane_division<T: Copy + std::ops::Div<Output = T>, const L: usize>(a: [T; L], b: [T; L]) -> [T; L] {
+    std::array::from_fn(|i| a[i] / b[i])
+}
+
+macro_rules! lane_root {
+    ($elem:ty, $lanes:literal) => {
+        |a: [$elem; $lanes], _: [$elem; $lanes]| -> [$elem; $lanes] { a.map(<$elem>::sqrt) }
+    };
+}
+
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
+))]
+fn div_f32x16(rounds: u64) -> (u64, f64) {
+    divider_chains!(rounds, [f32; 16], f32, 16, 12, |x| [x; 16], lane_division::<f32, 16>, |v: &[f32; 16]| v
+        .iter()
+        .map(|&x| f64::from(x))
+        .sum::<f64>())
+}
+
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
+))]
+fn sqrt_f32x16(rounds: u64) -> (u64, f64) {
+    divider_chains!(rounds, [f32; 16], f32, 16, 12, |x| [x; 16], lane_root!(f32, 16), |v: &[f32; 16]| v
+        .iter()
+        .map(|&x| f64::from(x))
+        .sum::<f64>())
+}
+
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
+))]
+fn div_f64x16(rounds: u64) -> (u64, f64) {
+    divider_chains!(rounds, [f64; 16], f64, 16, 12, |x| [x; 16], lane_division::<f64, 16>, |v: &[f64; 16]| v
+        .iter()
+        .sum::<f64>())
+}
+
+#[multiversion(targets(
+    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
+))]
+fn sqrt_f64x16(rounds: u64) -> (u64, f64) {
+    divider_chains!(rounds, [f64; 16], f64, 16, 12, |x| [x; 16], lane_root!(f64, 16), |v: &[f64; 16]| v
+        .iter()
+        .sum::<f64>())
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn div_f32x8(rounds: u64) -> (u64, f64) {
+    match_target! {
+        "x86_64+avx2" => {
+            use std::arch::x86_64::*;
+            divider_chains!(rounds, __m256, f32, 8, 12, _mm256_set1_ps, _mm256_div_ps, |v| {
+                let halves = _mm_add_ps(_mm256_castps256_ps128(*v), _mm256_extractf128_ps::<1>(*v));
+                let pairs = _mm_hadd_ps(halves, halves);
+                f64::from(_mm_cvtss_f32(_mm_hadd_ps(pairs, pairs)))
+            })
+        }
+        _ => divider_chains!(rounds, [f32; 8], f32, 8, 6, |x| [x; 8], lane_division::<f32, 8>, |v: &[f32; 8]| v
+            .iter()
+            .map(|&x| f64::from(x))
+            .sum::<f64>()),
+    }
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn sqrt_f32x8(rounds: u64) -> (u64, f64) {
+    match_target! {
+        "x86_64+avx2" => {
+            use std::arch::x86_64::*;
+            divider_chains!(rounds, __m256, f32, 8, 12, _mm256_set1_ps, |a, _| _mm256_sqrt_ps(a), |v| {
+                let halves = _mm_add_ps(_mm256_castps256_ps128(*v), _mm256_extractf128_ps::<1>(*v));
+                let pairs = _mm_hadd_ps(halves, halves);
+                f64::from(_mm_cvtss_f32(_mm_hadd_ps(pairs, pairs)))
+            })
+        }
+        _ => divider_chains!(rounds, [f32; 8], f32, 8, 6, |x| [x; 8], lane_root!(f32, 8), |v: &[f32; 8]| v
+            .iter()
+            .map(|&x| f64::from(x))
+            .sum::<f64>()),
+    }
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn div_f64x8(rounds: u64) -> (u64, f64) {
+    match_target! {
+        "x86_64+avx2" => {
+            use std::arch::x86_64::*;
+            divider_chains!(rounds, __m256d, f64, 4, 12, _mm256_set1_pd, _mm256_div_pd, |v| {
+                let halves = _mm_add_pd(_mm256_castpd256_pd128(*v), _mm256_extractf128_pd::<1>(*v));
+                _mm_cvtsd_f64(_mm_hadd_pd(halves, halves))
+            })
+        }
+        _ => divider_chains!(rounds, [f64; 8], f64, 8, 2, |x| [x; 8], lane_division::<f64, 8>, |v: &[f64; 8]| v
+            .iter()
+            .sum::<f64>()),
+    }
+}
+
+#[multiversion(targets("x86_64+avx2"))]
+fn sqrt_f64x8(rounds: u64) -> (u64, f64) {
+    match_target! {
+        "x86_64+avx2" => {
+            use std::arch::x86_64::*;
+            divider_chains!(rounds, __m256d, f64, 4, 12, _mm256_set1_pd, |a, _| _mm256_sqrt_pd(a), |v| {
+                let halves = _mm_add_pd(_mm256_castpd256_pd128(*v), _mm256_extractf128_pd::<1>(*v));
+                _mm_cvtsd_f64(_mm_hadd_pd(halves, halves))
+            })
+        }
+        _ => divider_chains!(rounds, [f64; 8], f64, 8, 2, |x| [x; 8], lane_root!(f64, 8), |v: &[f64; 8]| v
+            .iter()
+            .sum::<f64>()),
+    }
+}
+
+/// The scalar solver's code is compiled for the baseline instruction set.
+#[inline(never)]
+fn div_f32x1(rounds: u64) -> (u64, f64) {
+    divider_chains!(rounds, f32, f32, 1, 12, |x: f32| x, |a: f32, b: f32| a / b, |&v: &f32| f64::from(v))
+}
+
+#[inline(never)]
+fn sqrt_f32x1(rounds: u64) -> (u64, f64) {
+    divider_chains!(rounds, f32, f32, 1, 12, |x: f32| x, |a: f32, _: f32| a.sqrt(), |&v: &f32| f64::from(v))
+}
+
+#[inline(never)]
+fn div_f64x1(rounds: u64) -> (u64, f64) {
+    divider_chains!(rounds, f64, f64, 1, 12, |x: f64| x, |a: f64, b: f64| a / b, |&v: &f64| v)
+}
+
+#[inline(never)]
+fn sqrt_f64x1(rounds: u64) -> (u64, f64) {
+    divider_chains!(rounds, f64, f64, 1, 12, |x: f64| x, |a: f64, _: f64| a.sqrt(), |&v: &f64| v)
 }

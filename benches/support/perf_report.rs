@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-use crate::peak::Peak;
+use crate::peak::{Divider, Peak};
 
 // ---- allocation counting -----------------------------------------------------------------------------
 
@@ -294,6 +294,27 @@ pub const SUBSTEP_OPERATIONS: [(&str, f64, f64); 5] = [
     ("output and read-back, per substep share", 44.0, 0.0),
 ];
 
+/// The divisions and square roots among [`SUBSTEP_OPERATIONS`], per part: (single-precision divisions,
+/// single-precision square roots, double-precision divisions, double-precision square roots). They run on a
+/// divider that takes a new operation only every few cycles, so the bound prices them at their own measured
+/// rates (`Peak`'s dividers), not at the multiplies' and adds'. Counted as the totals are (the minimum the code
+/// runs).
+pub const SUBSTEP_DIVIDER_OPERATIONS: [(&str, f64, f64, f64, f64); 5] = [
+    // The orientation's normalise (a square root, then one division for the inverse length).
+    ("predict", 1.0, 1.0, 0.0, 0.0),
+    // Per iteration: the polar step's guard (the matrix's norm: a square root), Müller's step and the Newton
+    // step (one division each), the orientation's nlerp (normalise: a square root and a division); the centroid
+    // (three double-precision divisions). Times 2.
+    ("shape matching, 2 iterations", 6.0, 4.0, 6.0, 0.0),
+    // One division per bond in each forward pass (the elimination's pivot), one pass per iteration.
+    ("inextensibility, 2 iterations", 0.0, 0.0, 2.0, 0.0),
+    // The logarithm's series divides by the quaternion's w.
+    ("velocities", 1.0, 0.0, 0.0, 0.0),
+    // Per frame: the two captures' normalise (2 + 2), the output's nlerp (1 + 1), three bone directions (3
+    // square roots, 9 divisions), the swing's normalise (1 + 1) = 13 divisions and 7 square roots, / 4.
+    ("output and read-back, per substep share", 3.25, 1.75, 0.0, 0.0),
+];
+
 /// Bytes a frame streams per joint when the scene does not fit in cache (the chain loop runs all substeps
 /// of a chain back to back, so within a frame a chain's data stays in L1 after its first substep).
 pub const FRAME_BYTES: [(&str, f64); 5] = [
@@ -317,6 +338,11 @@ pub struct Bound {
     /// Single- and double-precision operations (`SUBSTEP_OPERATIONS`).
     pub f32_operations: f64,
     pub f64_operations: f64,
+    /// Among them, the divisions and square roots (`SUBSTEP_DIVIDER_OPERATIONS`).
+    pub f32_divisions: f64,
+    pub f32_roots: f64,
+    pub f64_divisions: f64,
+    pub f64_roots: f64,
     pub bytes_per_joint_frame: f64,
     /// Seconds per joint per substep if the operations ran at the measured scalar peak.
     pub scalar_compute: f64,
@@ -332,14 +358,33 @@ impl Bound {
         let f32_operations: f64 = SUBSTEP_OPERATIONS.iter().map(|(_, single, _)| single).sum();
         let f64_operations: f64 = SUBSTEP_OPERATIONS.iter().map(|(_, _, double)| double).sum();
         let bytes: f64 = FRAME_BYTES.iter().map(|(_, n)| n).sum();
+        for ((part, single, double), (divider_part, f32_div, f32_root, f64_div, f64_root)) in
+            SUBSTEP_OPERATIONS.iter().zip(&SUBSTEP_DIVIDER_OPERATIONS)
+        {
+            assert!(part == divider_part && f32_div + f32_root <= *single && f64_div + f64_root <= *double, "{part}");
+        }
+        let column = |pick: fn(&(&str, f64, f64, f64, f64)) -> f64| SUBSTEP_DIVIDER_OPERATIONS.iter().map(pick).sum();
+        let (f32_divisions, f32_roots): (f64, f64) = (column(|row| row.1), column(|row| row.2));
+        let (f64_divisions, f64_roots): (f64, f64) = (column(|row| row.3), column(|row| row.4));
         let peak = machine.peak;
+        // Multiplies and adds at their rate, divisions and square roots at theirs.
+        let time = |operations: f64, divisions: f64, roots: f64, arithmetic: f64, divider: Divider| {
+            (operations - divisions - roots) / arithmetic + divisions / divider.division + roots / divider.root
+        };
         Self {
             f32_operations,
             f64_operations,
+            f32_divisions,
+            f32_roots,
+            f64_divisions,
+            f64_roots,
             bytes_per_joint_frame: bytes,
-            // The scalar solver's doubles run at its floats' rate: one lane either way.
-            scalar_compute: (f32_operations + f64_operations) / peak.scalar_f32,
-            simd_compute: f32_operations / peak.simd_f32 + f64_operations / peak.simd_f64,
+            // The scalar solver's double-precision multiplies and adds run at its floats' rate: one lane either
+            // way (not so its divisions and square roots).
+            scalar_compute: time(f32_operations, f32_divisions, f32_roots, peak.scalar_f32, peak.scalar_f32_divider)
+                + time(f64_operations, f64_divisions, f64_roots, peak.scalar_f32, peak.scalar_f64_divider),
+            simd_compute: time(f32_operations, f32_divisions, f32_roots, peak.simd_f32, peak.simd_f32_divider)
+                + time(f64_operations, f64_divisions, f64_roots, peak.simd_f64, peak.simd_f64_divider),
             peak,
             memory: bytes / substeps_per_frame / machine.bandwidth,
         }
@@ -526,6 +571,22 @@ impl Report {
                     machine.peak.lanes,
                     machine.peak.simd_f32 / 1e9,
                     machine.peak.simd_f64 / 1e9
+                ),
+            ),
+            (
+                "single-thread divisions and square roots (measured: independent ones)",
+                format!(
+                    "scalar f32 {:.1} and {:.1}, f64 {:.2} and {:.2}; {}-lane SIMD f32 {:.1} and {:.1}, f64 {:.1} and {:.1} G \
+                     lane operations/s",
+                    machine.peak.scalar_f32_divider.division / 1e9,
+                    machine.peak.scalar_f32_divider.root / 1e9,
+                    machine.peak.scalar_f64_divider.division / 1e9,
+                    machine.peak.scalar_f64_divider.root / 1e9,
+                    machine.peak.lanes,
+                    machine.peak.simd_f32_divider.division / 1e9,
+                    machine.peak.simd_f32_divider.root / 1e9,
+                    machine.peak.simd_f64_divider.division / 1e9,
+                    machine.peak.simd_f64_divider.root / 1e9
                 ),
             ),
             ("load average at start", machine.load_average.clone().unwrap_or_else(|| "unknown".into())),
@@ -759,13 +820,27 @@ impl Report {
             "## Lower bound for 1000 x 16\n\nOperations per dynamic joint per substep, counted from the lane kernel's \
              code at default settings (add, subtract, multiply, divide, square root = 1; where the code iterates to a \
              tolerance the minimum it runs is counted, so this is a lower bound for the algorithm as written; the \
-             count is itemised in `benches/support/perf_report.rs`):\n\n\
-             | part | f32 operations | f64 operations |\n|---|---|---|\n"
+             count is itemised in `benches/support/perf_report.rs`). Among them the divisions and square roots, which \
+             the bound prices at their own measured rates:\n\n\
+             | part | f32 operations | f64 operations | of which f32 divisions, square roots | f64 divisions, square \
+             roots |\n|---|---|---|---|---|\n"
         );
-        for (part, single, double) in SUBSTEP_OPERATIONS {
-            let _ = writeln!(md, "| {part} | {single:.0} | {double:.0} |");
+        for ((part, single, double), (_, f32_div, f32_root, f64_div, f64_root)) in
+            SUBSTEP_OPERATIONS.iter().zip(SUBSTEP_DIVIDER_OPERATIONS)
+        {
+            let _ =
+                writeln!(md, "| {part} | {single:.0} | {double:.0} | {f32_div}, {f32_root} | {f64_div}, {f64_root} |");
         }
-        let _ = writeln!(md, "| total | {:.0} | {:.0} |\n", bound.f32_operations, bound.f64_operations);
+        let _ = writeln!(
+            md,
+            "| total | {:.0} | {:.0} | {}, {} | {}, {} |\n",
+            bound.f32_operations,
+            bound.f64_operations,
+            bound.f32_divisions,
+            bound.f32_roots,
+            bound.f64_divisions,
+            bound.f64_roots
+        );
         md.push_str(
             "Bytes per joint per frame streamed from memory when the scene does not fit in cache (a chain's substeps \
              run back to back, so its data is loaded once per frame):\n\n| data | bytes |\n|---|---|\n",
@@ -780,6 +855,8 @@ impl Report {
             md,
             "The compute lines run the operations at this core's measured peaks (the machine table): independent \
              multiplies and adds, never fused, since the kernel's determinism policy rules out fused multiply-adds; \
+             divisions and square roots at the divider's measured rates (the reports up to commit f5958c3 priced them \
+             like multiplies, a rate no divider reaches: the SIMD line was 23.6 ns there); \
              single- and double-precision operations each at their own rate.\n\n\
              | bound (per joint per substep) | ns | lane solver (plain): measured / bound \
              | scalar solver (plain, scalar solver): measured / bound |\n|---|---|---|---|\n\

@@ -298,7 +298,7 @@ pub const SUBSTEP_OPERATIONS: [(&str, f64, f64); 5] = [
 /// single-precision square roots, double-precision divisions, double-precision square roots). They run on a
 /// divider that takes a new operation only every few cycles, so the bound prices them at their own measured
 /// rates (`Peak`'s dividers), not at the multiplies' and adds'. Counted as the totals are (the minimum the code
-/// runs). `tools/divider_ops.py` counts what runs, from callgrind: on `scene_cost 20 1000x16` (built at 543fee1)
+/// runs). `tools/divider_ops.py` counts what runs, from callgrind: on `scene_cost 20 1000x16` (built at 9acea66)
 /// 14.37 single-precision divisions, 7.47 square roots and 10.74 double-precision divisions per joint per
 /// substep, above these minimums (second polar passes, second forward passes).
 pub const SUBSTEP_DIVIDER_OPERATIONS: [(&str, f64, f64, f64, f64); 5] = [

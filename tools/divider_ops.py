@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Divisions and square roots executed per dynamic joint per substep, in lane operations (a 256-bit `vdivps`
-counts 8, a `vdivpd` 4, a scalar `divss` 1): the check on the counts of `SUBSTEP_DIVIDER_OPERATIONS` in
+counts 8, a `vdivpd` 4, a scalar `divss` 1): the check on the division and square-root counts of `SUBSTEP_WORK` in
 `benches/support/perf_report.rs`, which are minimums and so must not exceed what runs. Runs `scene_cost` under
 callgrind for FRAMES frames and for none (the setup alone) and takes the difference.
 

@@ -149,16 +149,33 @@ fn lanewise<T: Copy, const L: usize>(op: impl Fn(T, T) -> T) -> impl Fn([T; L], 
     move |a, b| std::array::from_fn(|i| op(a[i], b[i]))
 }
 
+/// The lanes of an AVX2 register summed (only to keep every chain's result alive), for code that has
+/// `std::arch::x86_64::*` in scope and AVX2 enabled.
+macro_rules! sum_ps {
+    () => {
+        |v: &__m256| {
+            let halves = _mm_add_ps(_mm256_castps256_ps128(*v), _mm256_extractf128_ps::<1>(*v));
+            let pairs = _mm_hadd_ps(halves, halves);
+            f64::from(_mm_cvtss_f32(_mm_hadd_ps(pairs, pairs)))
+        }
+    };
+}
+
+macro_rules! sum_pd {
+    () => {
+        |v: &__m256d| {
+            let halves = _mm_add_pd(_mm256_castpd256_pd128(*v), _mm256_extractf128_pd::<1>(*v));
+            _mm_cvtsd_f64(_mm_hadd_pd(halves, halves))
+        }
+    };
+}
+
 #[multiversion(targets("x86_64+avx2"))]
 fn f32x8(rounds: u64) -> (u64, f64) {
     match_target! {
         "x86_64+avx2" => {
             use std::arch::x86_64::*;
-            chains!(rounds, __m256, f32, 8, 12, _mm256_set1_ps, _mm256_mul_ps, _mm256_add_ps, |v| {
-                let halves = _mm_add_ps(_mm256_castps256_ps128(*v), _mm256_extractf128_ps::<1>(*v));
-                let pairs = _mm_hadd_ps(halves, halves);
-                f64::from(_mm_cvtss_f32(_mm_hadd_ps(pairs, pairs)))
-            })
+            chains!(rounds, __m256, f32, 8, 12, _mm256_set1_ps, _mm256_mul_ps, _mm256_add_ps, sum_ps!())
         }
         // The portable kernel (SSE2, NEON): arrays, few enough chains for 16 128-bit registers.
         _ => chains!(
@@ -180,10 +197,7 @@ fn f64x8(rounds: u64) -> (u64, f64) {
     match_target! {
         "x86_64+avx2" => {
             use std::arch::x86_64::*;
-            chains!(rounds, __m256d, f64, 4, 12, _mm256_set1_pd, _mm256_mul_pd, _mm256_add_pd, |v| {
-                let halves = _mm_add_pd(_mm256_castpd256_pd128(*v), _mm256_extractf128_pd::<1>(*v));
-                _mm_cvtsd_f64(_mm_hadd_pd(halves, halves))
-            })
+            chains!(rounds, __m256d, f64, 4, 12, _mm256_set1_pd, _mm256_mul_pd, _mm256_add_pd, sum_pd!())
         }
         _ => chains!(
             rounds,
@@ -236,111 +250,51 @@ macro_rules! lane_root {
     };
 }
 
-#[multiversion(targets(
-    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
-))]
-fn div_f32x16(rounds: u64) -> (u64, f64) {
-    divider_chains!(rounds, [f32; 16], f32, 16, 12, |x| [x; 16], lane_division::<f32, 16>, |v: &[f32; 16]| v
-        .iter()
-        .map(|&x| f64::from(x))
-        .sum::<f64>())
-}
-
-#[multiversion(targets(
-    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
-))]
-fn sqrt_f32x16(rounds: u64) -> (u64, f64) {
-    divider_chains!(rounds, [f32; 16], f32, 16, 12, |x| [x; 16], lane_root!(f32, 16), |v: &[f32; 16]| v
-        .iter()
-        .map(|&x| f64::from(x))
-        .sum::<f64>())
-}
-
-#[multiversion(targets(
-    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
-))]
-fn div_f64x16(rounds: u64) -> (u64, f64) {
-    divider_chains!(rounds, [f64; 16], f64, 16, 12, |x| [x; 16], lane_division::<f64, 16>, |v: &[f64; 16]| v
-        .iter()
-        .sum::<f64>())
-}
-
-#[multiversion(targets(
-    "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
-))]
-fn sqrt_f64x16(rounds: u64) -> (u64, f64) {
-    divider_chains!(rounds, [f64; 16], f64, 16, 12, |x| [x; 16], lane_root!(f64, 16), |v: &[f64; 16]| v
-        .iter()
-        .sum::<f64>())
-}
-
-#[multiversion(targets("x86_64+avx2"))]
-fn div_f32x8(rounds: u64) -> (u64, f64) {
-    match_target! {
-        "x86_64+avx2" => {
-            use std::arch::x86_64::*;
-            divider_chains!(rounds, __m256, f32, 8, 12, _mm256_set1_ps, _mm256_div_ps, |v| {
-                let halves = _mm_add_ps(_mm256_castps256_ps128(*v), _mm256_extractf128_ps::<1>(*v));
-                let pairs = _mm_hadd_ps(halves, halves);
-                f64::from(_mm_cvtss_f32(_mm_hadd_ps(pairs, pairs)))
-            })
+/// A division or square root probe for the 16-lane (AVX-512) kernel: arrays, as [`f32x16`].
+macro_rules! divider16 {
+    ($name:ident, $elem:ty, $op:expr) => {
+        #[multiversion(targets(
+            "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
+        ))]
+        fn $name(rounds: u64) -> (u64, f64) {
+            divider_chains!(rounds, [$elem; 16], $elem, 16, 12, |x| [x; 16], $op, |v: &[$elem; 16]| v
+                .iter()
+                .map(|&x| x as f64)
+                .sum::<f64>())
         }
-        _ => divider_chains!(rounds, [f32; 8], f32, 8, 6, |x| [x; 8], lane_division::<f32, 8>, |v: &[f32; 8]| v
-            .iter()
-            .map(|&x| f64::from(x))
-            .sum::<f64>()),
-    }
+    };
 }
 
-#[multiversion(targets("x86_64+avx2"))]
-fn sqrt_f32x8(rounds: u64) -> (u64, f64) {
-    match_target! {
-        "x86_64+avx2" => {
-            use std::arch::x86_64::*;
-            divider_chains!(rounds, __m256, f32, 8, 12, _mm256_set1_ps, |a, _| _mm256_sqrt_ps(a), |v| {
-                let halves = _mm_add_ps(_mm256_castps256_ps128(*v), _mm256_extractf128_ps::<1>(*v));
-                let pairs = _mm_hadd_ps(halves, halves);
-                f64::from(_mm_cvtss_f32(_mm_hadd_ps(pairs, pairs)))
-            })
+divider16!(div_f32x16, f32, lane_division::<f32, 16>);
+divider16!(sqrt_f32x16, f32, lane_root!(f32, 16));
+divider16!(div_f64x16, f64, lane_division::<f64, 16>);
+divider16!(sqrt_f64x16, f64, lane_root!(f64, 16));
+
+/// A division or square root probe for the 8-lane kernel: AVX2 intrinsics where the CPU has them (`$lanes` per
+/// register, 12 chains), arrays of 8 in the portable copy (`$portable_chains` of them), as [`f32x8`] and
+/// [`f64x8`]. `$avx2` and `$sum` may name `std::arch::x86_64` items.
+macro_rules! divider8 {
+    ($name:ident, $vector:ty, $elem:ty, $lanes:literal, $splat:expr, $avx2:expr, $sum:expr, $portable_chains:literal, $portable:expr) => {
+        #[multiversion(targets("x86_64+avx2"))]
+        fn $name(rounds: u64) -> (u64, f64) {
+            match_target! {
+                "x86_64+avx2" => {
+                    use std::arch::x86_64::*;
+                    divider_chains!(rounds, $vector, $elem, $lanes, 12, $splat, $avx2, $sum)
+                }
+                _ => divider_chains!(rounds, [$elem; 8], $elem, 8, $portable_chains, |x| [x; 8], $portable, |v: &[$elem; 8]| v
+                    .iter()
+                    .map(|&x| x as f64)
+                    .sum::<f64>()),
+            }
         }
-        _ => divider_chains!(rounds, [f32; 8], f32, 8, 6, |x| [x; 8], lane_root!(f32, 8), |v: &[f32; 8]| v
-            .iter()
-            .map(|&x| f64::from(x))
-            .sum::<f64>()),
-    }
+    };
 }
 
-#[multiversion(targets("x86_64+avx2"))]
-fn div_f64x8(rounds: u64) -> (u64, f64) {
-    match_target! {
-        "x86_64+avx2" => {
-            use std::arch::x86_64::*;
-            divider_chains!(rounds, __m256d, f64, 4, 12, _mm256_set1_pd, _mm256_div_pd, |v| {
-                let halves = _mm_add_pd(_mm256_castpd256_pd128(*v), _mm256_extractf128_pd::<1>(*v));
-                _mm_cvtsd_f64(_mm_hadd_pd(halves, halves))
-            })
-        }
-        _ => divider_chains!(rounds, [f64; 8], f64, 8, 2, |x| [x; 8], lane_division::<f64, 8>, |v: &[f64; 8]| v
-            .iter()
-            .sum::<f64>()),
-    }
-}
-
-#[multiversion(targets("x86_64+avx2"))]
-fn sqrt_f64x8(rounds: u64) -> (u64, f64) {
-    match_target! {
-        "x86_64+avx2" => {
-            use std::arch::x86_64::*;
-            divider_chains!(rounds, __m256d, f64, 4, 12, _mm256_set1_pd, |a, _| _mm256_sqrt_pd(a), |v| {
-                let halves = _mm_add_pd(_mm256_castpd256_pd128(*v), _mm256_extractf128_pd::<1>(*v));
-                _mm_cvtsd_f64(_mm_hadd_pd(halves, halves))
-            })
-        }
-        _ => divider_chains!(rounds, [f64; 8], f64, 8, 2, |x| [x; 8], lane_root!(f64, 8), |v: &[f64; 8]| v
-            .iter()
-            .sum::<f64>()),
-    }
-}
+divider8!(div_f32x8, __m256, f32, 8, _mm256_set1_ps, _mm256_div_ps, sum_ps!(), 6, lane_division::<f32, 8>);
+divider8!(sqrt_f32x8, __m256, f32, 8, _mm256_set1_ps, |a, _| _mm256_sqrt_ps(a), sum_ps!(), 6, lane_root!(f32, 8));
+divider8!(div_f64x8, __m256d, f64, 4, _mm256_set1_pd, _mm256_div_pd, sum_pd!(), 2, lane_division::<f64, 8>);
+divider8!(sqrt_f64x8, __m256d, f64, 4, _mm256_set1_pd, |a, _| _mm256_sqrt_pd(a), sum_pd!(), 2, lane_root!(f64, 8));
 
 /// The scalar solver's code is compiled for the baseline instruction set.
 #[inline(never)]

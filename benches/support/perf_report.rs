@@ -263,59 +263,65 @@ fn stream_bandwidth() -> f64 {
 
 // ---- a lower bound for the rod --------------------------------------------------------------------------
 
+/// One part of a substep's work per dynamic joint ([`SUBSTEP_WORK`]): its single- and double-precision
+/// operations, and the divisions and square roots among them.
+pub struct Work {
+    pub part: &'static str,
+    pub f32_operations: f64,
+    pub f64_operations: f64,
+    pub f32_divisions: f64,
+    pub f32_roots: f64,
+    pub f64_divisions: f64,
+    pub f64_roots: f64,
+}
+
 /// Work of one internal substep per dynamic joint at default settings, counted from the lane kernel's code
-/// (`src/core/lanes/`: the scalar solver's operations, lane by lane), as (single-precision, double-precision)
-/// operations. Counting rule: add, subtract, multiply, divide and square root 1 operation each; loop control,
-/// comparisons, selects and conversions free. Building blocks: quaternion product 28, quaternion to matrix
-/// 24, normalise 13, the exponential's series 26, the logarithm's series 21. Where the code iterates to a
+/// (`src/core/lanes/`: the scalar solver's operations, lane by lane). Counting rule: add, subtract, multiply,
+/// divide and square root 1 operation each; loop control, comparisons, selects and conversions free. Building
+/// blocks: quaternion product 28, quaternion to matrix 24, normalise 13 (a square root and a division among
+/// them), the exponential's series 26, the logarithm's series 21 (a division). Where the code iterates to a
 /// tolerance the minimum it runs is counted (one polar step per group, one forward pass and one back
 /// substitution per inextensibility solve), so the total is a lower bound for the algorithm as written.
-pub const SUBSTEP_OPERATIONS: [(&str, f64, f64); 5] = [
+///
+/// The divisions and square roots run on a divider that takes a new operation only every few cycles, so the
+/// bound prices them at their own measured rates (`Peak`'s dividers), not at the multiplies' and adds'.
+/// `tools/divider_ops.py` counts what runs, from callgrind: on `scene_cost 20 1000x16` (built at 9acea66) 14.37
+/// single-precision divisions, 7.47 square roots and 10.74 double-precision divisions per joint per substep,
+/// above the minimums counted here (second polar passes, second forward passes).
+pub const SUBSTEP_WORK: [Work; 5] = [
     // Velocity relative to the root, decay and gravity (15), angular decay (3), position predict (3 f32, 3
     // f64), orientation predict: scaled turn (3), exponential (26), product (28), normalise (13).
-    ("predict", 91.0, 3.0),
+    Work::new("predict", (91.0, 3.0), [1.0, 1.0, 0.0, 0.0]),
     // Per iteration (2 at default) of an interior group: 2 orientation terms (product 28, to matrix 24, weight
     // 9) = 122; centroid (9 adds, 3 divisions: f64); 3 offsets from it (9 f64), outer products (27) and the
-    // sum of 6 matrices (45); the polar step: its guard (20), one step (rotation matrix 24, S = R^T A 45,
-    // gradient and trace 5, Mueller's step 5, convergence 5, the Newton step 58, exponential 26, product 28,
-    // renormalise 13 = 209), the final matrix (24); goals for 3 particles (matrix times offset 15 each; in
-    // f64 the goal and the pull, 12 each); orientation: product (28) and nlerp (33). Per iteration 553 f32 and
-    // 57 f64, times 2.
-    ("shape matching, 2 iterations", 1106.0, 114.0),
+    // sum of 6 matrices (45); the polar step: its guard (20, the matrix's norm: a square root), one step
+    // (rotation matrix 24, S = R^T A 45, gradient and trace 5, Mueller's step 5 (a division), convergence 5,
+    // the Newton step 58 (a division), exponential 26, product 28, renormalise 13 = 209), the final matrix
+    // (24); goals for 3 particles (matrix times offset 15 each; in f64 the goal and the pull, 12 each);
+    // orientation: product (28) and nlerp (33: a normalise). Per iteration 553 f32 and 57 f64, times 2.
+    Work::new("shape matching, 2 iterations", (1106.0, 114.0), [6.0, 4.0, 6.0, 0.0]),
     // Start bonds (3, once per substep); per iteration and bond, all f64: the forward pass row (bond 3,
-    // residual 7, three dot products 15, elimination 9 = 34), back substitution (2), the error after the step
-    // (18), applying the multipliers (12) = 66, times 2.
-    ("inextensibility, 2 iterations", 0.0, 135.0),
+    // residual 7, three dot products 15, elimination 9 with its pivot's division = 34), back substitution (2),
+    // the error after the step (18), applying the multipliers (12) = 66, times 2.
+    Work::new("inextensibility, 2 iterations", (0.0, 135.0), [0.0, 0.0, 2.0, 0.0]),
     // Linear velocity (3 f64, 3 f32); relative rotation (28), hemisphere (7), logarithm's series (21), scale
     // (3).
-    ("velocities", 62.0, 3.0),
+    Work::new("velocities", (62.0, 3.0), [1.0, 0.0, 0.0, 0.0]),
     // Per frame, shared by the 4 substeps of a 60 Hz frame: local capture (2 x ~40), interpolated output
-    // (~60), world read-back (~35) = 175 / 4.
-    ("output and read-back, per substep share", 44.0, 0.0),
+    // (~60), world read-back (~35) = 175 / 4. Divisions and square roots per frame: the two captures'
+    // normalise (2 + 2), the output's nlerp (1 + 1), three bone directions (9 divisions, 3 square roots), the
+    // swing's normalise (1 + 1) = 13 and 7, / 4.
+    Work::new("output and read-back, per substep share", (44.0, 0.0), [3.25, 1.75, 0.0, 0.0]),
 ];
 
-/// The divisions and square roots among [`SUBSTEP_OPERATIONS`], per part: (single-precision divisions,
-/// single-precision square roots, double-precision divisions, double-precision square roots). They run on a
-/// divider that takes a new operation only every few cycles, so the bound prices them at their own measured
-/// rates (`Peak`'s dividers), not at the multiplies' and adds'. Counted as the totals are (the minimum the code
-/// runs). `tools/divider_ops.py` counts what runs, from callgrind: on `scene_cost 20 1000x16` (built at 9acea66)
-/// 14.37 single-precision divisions, 7.47 square roots and 10.74 double-precision divisions per joint per
-/// substep, above these minimums (second polar passes, second forward passes).
-pub const SUBSTEP_DIVIDER_OPERATIONS: [(&str, f64, f64, f64, f64); 5] = [
-    // The orientation's normalise (a square root, then one division for the inverse length).
-    ("predict", 1.0, 1.0, 0.0, 0.0),
-    // Per iteration: the polar step's guard (the matrix's norm: a square root), Müller's step and the Newton
-    // step (one division each), the orientation's nlerp (normalise: a square root and a division); the centroid
-    // (three double-precision divisions). Times 2.
-    ("shape matching, 2 iterations", 6.0, 4.0, 6.0, 0.0),
-    // One division per bond in each forward pass (the elimination's pivot), one pass per iteration.
-    ("inextensibility, 2 iterations", 0.0, 0.0, 2.0, 0.0),
-    // The logarithm's series divides by the quaternion's w.
-    ("velocities", 1.0, 0.0, 0.0, 0.0),
-    // Per frame: the two captures' normalise (2 + 2), the output's nlerp (1 + 1), three bone directions (3
-    // square roots, 9 divisions), the swing's normalise (1 + 1) = 13 divisions and 7 square roots, / 4.
-    ("output and read-back, per substep share", 3.25, 1.75, 0.0, 0.0),
-];
+impl Work {
+    /// `part`'s (single, double)-precision operations, and among them `[f32 divisions, f32 square roots, f64
+    /// divisions, f64 square roots]`.
+    const fn new(part: &'static str, (f32_operations, f64_operations): (f64, f64), divider: [f64; 4]) -> Self {
+        let [f32_divisions, f32_roots, f64_divisions, f64_roots] = divider;
+        Self { part, f32_operations, f64_operations, f32_divisions, f32_roots, f64_divisions, f64_roots }
+    }
+}
 
 /// Bytes a frame streams per joint when the scene does not fit in cache (the chain loop runs all substeps
 /// of a chain back to back, so within a frame a chain's data stays in L1 after its first substep).
@@ -337,10 +343,10 @@ pub const FRAME_BYTES: [(&str, f64); 5] = [
 pub const WORKING_SET_BYTES_PER_JOINT: f64 = 236.0;
 
 pub struct Bound {
-    /// Single- and double-precision operations (`SUBSTEP_OPERATIONS`).
+    /// Single- and double-precision operations (`SUBSTEP_WORK`).
     pub f32_operations: f64,
     pub f64_operations: f64,
-    /// Among them, the divisions and square roots (`SUBSTEP_DIVIDER_OPERATIONS`).
+    /// Among them, the divisions and square roots.
     pub f32_divisions: f64,
     pub f32_roots: f64,
     pub f64_divisions: f64,
@@ -357,17 +363,16 @@ pub struct Bound {
 
 impl Bound {
     pub fn new(machine: &Machine, substeps_per_frame: f64) -> Self {
-        let f32_operations: f64 = SUBSTEP_OPERATIONS.iter().map(|(_, single, _)| single).sum();
-        let f64_operations: f64 = SUBSTEP_OPERATIONS.iter().map(|(_, _, double)| double).sum();
-        let bytes: f64 = FRAME_BYTES.iter().map(|(_, n)| n).sum();
-        for ((part, single, double), (divider_part, f32_div, f32_root, f64_div, f64_root)) in
-            SUBSTEP_OPERATIONS.iter().zip(&SUBSTEP_DIVIDER_OPERATIONS)
-        {
-            assert!(part == divider_part && f32_div + f32_root <= *single && f64_div + f64_root <= *double, "{part}");
+        for w in &SUBSTEP_WORK {
+            let fits =
+                w.f32_divisions + w.f32_roots <= w.f32_operations && w.f64_divisions + w.f64_roots <= w.f64_operations;
+            assert!(fits, "{}: more divisions and square roots than operations", w.part);
         }
-        let column = |pick: fn(&(&str, f64, f64, f64, f64)) -> f64| SUBSTEP_DIVIDER_OPERATIONS.iter().map(pick).sum();
-        let (f32_divisions, f32_roots): (f64, f64) = (column(|row| row.1), column(|row| row.2));
-        let (f64_divisions, f64_roots): (f64, f64) = (column(|row| row.3), column(|row| row.4));
+        let total = |pick: fn(&Work) -> f64| SUBSTEP_WORK.iter().map(pick).sum::<f64>();
+        let (f32_operations, f64_operations) = (total(|w| w.f32_operations), total(|w| w.f64_operations));
+        let (f32_divisions, f32_roots) = (total(|w| w.f32_divisions), total(|w| w.f32_roots));
+        let (f64_divisions, f64_roots) = (total(|w| w.f64_divisions), total(|w| w.f64_roots));
+        let bytes: f64 = FRAME_BYTES.iter().map(|(_, n)| n).sum();
         let peak = machine.peak;
         // Multiplies and adds at their rate, divisions and square roots at theirs.
         let time = |operations: f64, divisions: f64, roots: f64, arithmetic: f64, divider: Divider| {
@@ -827,11 +832,12 @@ impl Report {
              | part | f32 operations | f64 operations | of which f32 divisions, square roots | f64 divisions, square \
              roots |\n|---|---|---|---|---|\n"
         );
-        for ((part, single, double), (_, f32_div, f32_root, f64_div, f64_root)) in
-            SUBSTEP_OPERATIONS.iter().zip(SUBSTEP_DIVIDER_OPERATIONS)
-        {
-            let _ =
-                writeln!(md, "| {part} | {single:.0} | {double:.0} | {f32_div}, {f32_root} | {f64_div}, {f64_root} |");
+        for w in &SUBSTEP_WORK {
+            let _ = writeln!(
+                md,
+                "| {} | {:.0} | {:.0} | {}, {} | {}, {} |",
+                w.part, w.f32_operations, w.f64_operations, w.f32_divisions, w.f32_roots, w.f64_divisions, w.f64_roots
+            );
         }
         let _ = writeln!(
             md,

@@ -343,14 +343,8 @@ pub const FRAME_BYTES: [(&str, f64); 5] = [
 pub const WORKING_SET_BYTES_PER_JOINT: f64 = 236.0;
 
 pub struct Bound {
-    /// Single- and double-precision operations (`SUBSTEP_WORK`).
-    pub f32_operations: f64,
-    pub f64_operations: f64,
-    /// Among them, the divisions and square roots.
-    pub f32_divisions: f64,
-    pub f32_roots: f64,
-    pub f64_divisions: f64,
-    pub f64_roots: f64,
+    /// The sum of `SUBSTEP_WORK`.
+    pub work: Work,
     pub bytes_per_joint_frame: f64,
     /// Seconds per joint per substep if the operations ran at the measured scalar peak.
     pub scalar_compute: f64,
@@ -369,29 +363,29 @@ impl Bound {
             assert!(fits, "{}: more divisions and square roots than operations", w.part);
         }
         let total = |pick: fn(&Work) -> f64| SUBSTEP_WORK.iter().map(pick).sum::<f64>();
-        let (f32_operations, f64_operations) = (total(|w| w.f32_operations), total(|w| w.f64_operations));
-        let (f32_divisions, f32_roots) = (total(|w| w.f32_divisions), total(|w| w.f32_roots));
-        let (f64_divisions, f64_roots) = (total(|w| w.f64_divisions), total(|w| w.f64_roots));
+        let work = Work::new(
+            "total",
+            (total(|w| w.f32_operations), total(|w| w.f64_operations)),
+            [total(|w| w.f32_divisions), total(|w| w.f32_roots), total(|w| w.f64_divisions), total(|w| w.f64_roots)],
+        );
         let bytes: f64 = FRAME_BYTES.iter().map(|(_, n)| n).sum();
         let peak = machine.peak;
+        let w = &work;
         // Multiplies and adds at their rate, divisions and square roots at theirs.
         let time = |operations: f64, divisions: f64, roots: f64, arithmetic: f64, divider: Divider| {
             (operations - divisions - roots) / arithmetic + divisions / divider.division + roots / divider.root
         };
+        let f32_time = |arithmetic, divider| time(w.f32_operations, w.f32_divisions, w.f32_roots, arithmetic, divider);
+        let f64_time = |arithmetic, divider| time(w.f64_operations, w.f64_divisions, w.f64_roots, arithmetic, divider);
         Self {
-            f32_operations,
-            f64_operations,
-            f32_divisions,
-            f32_roots,
-            f64_divisions,
-            f64_roots,
-            bytes_per_joint_frame: bytes,
             // The scalar solver's double-precision multiplies and adds run at its floats' rate: one lane either
             // way (not so its divisions and square roots).
-            scalar_compute: time(f32_operations, f32_divisions, f32_roots, peak.scalar_f32, peak.scalar_f32_divider)
-                + time(f64_operations, f64_divisions, f64_roots, peak.scalar_f32, peak.scalar_f64_divider),
-            simd_compute: time(f32_operations, f32_divisions, f32_roots, peak.simd_f32, peak.simd_f32_divider)
-                + time(f64_operations, f64_divisions, f64_roots, peak.simd_f64, peak.simd_f64_divider),
+            scalar_compute: f32_time(peak.scalar_f32, peak.scalar_f32_divider)
+                + f64_time(peak.scalar_f32, peak.scalar_f64_divider),
+            simd_compute: f32_time(peak.simd_f32, peak.simd_f32_divider)
+                + f64_time(peak.simd_f64, peak.simd_f64_divider),
+            work,
+            bytes_per_joint_frame: bytes,
             peak,
             memory: bytes / substeps_per_frame / machine.bandwidth,
         }
@@ -832,23 +826,14 @@ impl Report {
              | part | f32 operations | f64 operations | of which f32 divisions, square roots | f64 divisions, square \
              roots |\n|---|---|---|---|---|\n"
         );
-        for w in &SUBSTEP_WORK {
+        for w in SUBSTEP_WORK.iter().chain([&bound.work]) {
             let _ = writeln!(
                 md,
                 "| {} | {:.0} | {:.0} | {}, {} | {}, {} |",
                 w.part, w.f32_operations, w.f64_operations, w.f32_divisions, w.f32_roots, w.f64_divisions, w.f64_roots
             );
         }
-        let _ = writeln!(
-            md,
-            "| total | {:.0} | {:.0} | {}, {} | {}, {} |\n",
-            bound.f32_operations,
-            bound.f64_operations,
-            bound.f32_divisions,
-            bound.f32_roots,
-            bound.f64_divisions,
-            bound.f64_roots
-        );
+        md.push('\n');
         md.push_str(
             "Bytes per joint per frame streamed from memory when the scene does not fit in cache (a chain's substeps \
              run back to back, so its data is loaded once per frame):\n\n| data | bytes |\n|---|---|\n",

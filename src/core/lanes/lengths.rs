@@ -145,19 +145,53 @@ fn forward_pass<const L: usize>(g: &mut LaneGroup<L>, corrected: bool, passes: &
     pass
 }
 
-/// Bond `k`'s row inputs.
+/// Bond `k`'s row inputs; `first` and `last` say whether it is the chain's first or last bond.
 #[inline(always)]
-fn bond<'a, const L: usize>(k: usize, d: &'a [DV3<L>], l2: &'a [D<L>], inv_l2: &'a [D<L>]) -> Bond<'a, L> {
-    let last = d.len() - 1;
+fn bond<'a, const L: usize>(
+    k: usize,
+    (first, last): (bool, bool),
+    d: &'a [DV3<L>],
+    l2: &'a [D<L>],
+    inv_l2: &'a [D<L>],
+) -> Bond<'a, L> {
+    let end = d.len() - 1;
     Bond {
-        k,
+        first,
         last,
         length_squared: &l2[k],
         inverse_length_squared: &inv_l2[k],
         lower: &d[k.saturating_sub(1)],
         own: &d[k],
-        upper: &d[(k + 1).min(last)],
+        upper: &d[(k + 1).min(end)],
     }
+}
+
+/// Runs `$row` for every bond `$k` of `$m`, root to tip, with `$ends` = (first bond, last bond), and with the first
+/// and the last bond peeled off the loop: the row code of the bonds between them has no test of the chain's ends
+/// (with the ends tested per bond, the compiler loaded the neighbours' bonds under masks, `vmaskmovpd`, and built
+/// the masks for every bond). A macro, not a function taking a closure: the closure's captured slices lose what
+/// the compiler knows of their not overlapping, and the lane loops ran in scalar instructions.
+macro_rules! each_bond {
+    ($m:expr, |$k:ident, $ends:ident| $row:block) => {{
+        let m = $m;
+        if m == 1 {
+            let ($k, $ends) = (0, (true, true));
+            $row
+        } else {
+            {
+                let ($k, $ends) = (0, (true, false));
+                $row
+            }
+            for $k in 1..m - 1 {
+                let $ends = (false, false);
+                $row
+            }
+            {
+                let ($k, $ends) = (m - 1, (false, true));
+                $row
+            }
+        }
+    }};
 }
 
 /// The first pass: the bonds of `p`.
@@ -172,14 +206,14 @@ pub fn first_pass<const L: usize>(
     d_prime: &mut [D<L>],
     pass: &mut ForwardPass<L>,
 ) {
-    for k in 0..d.len() {
-        let bond = bond(k, d, l2, inv_l2);
+    each_bond!(d.len(), |k, ends| {
+        let bond = bond(k, ends, d, l2, inv_l2);
         let (tip, start) = (&p[k + 1], &p[k]);
         let (c_row, d_row) = (&mut c_prime[k], &mut d_prime[k]);
         for lane in 0..L {
             pass.row(lane, sub(tip.get(lane), start.get(lane)), &bond, c_row, d_row);
         }
-    }
+    });
 }
 
 /// A later pass: `p` moved by the multipliers `mu` along the start bonds (`inextensible::shift`), kept in
@@ -199,28 +233,28 @@ pub fn corrected_pass<const L: usize>(
 ) {
     let m = d.len();
     corrected[0] = p[0];
-    for k in 0..m {
-        let bond = bond(k, d, l2, inv_l2);
+    each_bond!(m, |k, ends| {
+        let bond = bond(k, ends, d, l2, inv_l2);
         let tip = &p[k + 1];
         let (own_mu, upper_mu) = (&mu[k], &mu[(k + 1).min(m - 1)]);
-        let end = k + 1 == m;
         let (below, at) = corrected.split_at_mut(k + 1);
         let (start, moved_tip) = (&below[k], &mut at[0]);
         let (c_row, d_row) = (&mut c_prime[k], &mut d_prime[k]);
         for lane in 0..L {
-            let shift = bond_shift(bond.own.get(lane), own_mu.0[lane], bond.upper.get(lane), upper_mu.0[lane], end);
+            let shift =
+                bond_shift(bond.own.get(lane), own_mu.0[lane], bond.upper.get(lane), upper_mu.0[lane], bond.last);
             let moved = add(tip.get(lane), shift);
             moved_tip.set(lane, moved);
             pass.row(lane, sub(moved, start.get(lane)), &bond, c_row, d_row);
         }
-    }
+    });
 }
 
 /// What one bond's row of the pass reads.
 struct Bond<'a, const L: usize> {
-    k: usize,
-    /// The last bond's index.
-    last: usize,
+    /// Whether this is the chain's first bond (none below it) or its last (none above it).
+    first: bool,
+    last: bool,
     length_squared: &'a D<L>,
     inverse_length_squared: &'a D<L>,
     /// The start bonds before, of and after this one (clamped at the ends, where they do not count).
@@ -262,9 +296,9 @@ impl<const L: usize> ForwardPass<L> {
         // the loop from being vectorised.
         let (own, lower, upper) =
             (dot(b, bond.own.get(lane)), -dot(b, bond.lower.get(lane)), -dot(b, bond.upper.get(lane)));
-        let diagonal = if bond.k > 0 { own * 2.0 } else { own };
-        let lower = if bond.k > 0 { lower } else { 0.0 };
-        let upper = if bond.k < bond.last { upper } else { 0.0 };
+        let diagonal = if bond.first { own } else { own * 2.0 };
+        let lower = if bond.first { 0.0 } else { lower };
+        let upper = if bond.last { 0.0 } else { upper };
         let den = diagonal - lower * self.c_last.0[lane];
         let diagonal_size = diagonal.abs();
         let scale = self.scale.0[lane];

@@ -12,7 +12,7 @@ use std::time::Instant;
 use multiversion::multiversion;
 use multiversion::target::match_target;
 
-/// Rounds of one timed pass: about 100 ms at a peak of 1e11 lane operations per second for 16 lanes.
+/// Rounds of one timed pass: about 2 ms at a peak of 1e11 lane operations per second for 16 lanes (12 chains).
 const ROUNDS: u64 = 1 << 20;
 
 /// Lane operations per second, best of a few passes.
@@ -42,10 +42,16 @@ impl Peak {
     /// `sixteen`: the lane solver ran its 16-lane (AVX-512) kernel; else its 8-lane one (AVX2 where the CPU has
     /// it, else the portable copy).
     pub fn measure(sixteen: bool) -> Self {
+        Self::measure_with(sixteen, 5)
+    }
+
+    /// [`measure`](Self::measure) with each rate the best of `passes` timed passes (a few milliseconds each).
+    pub fn measure_with(sixteen: bool, passes: usize) -> Self {
+        let best = |run| best_of(run, ROUNDS, passes);
         let (simd_f32, simd_f64) = if sixteen { (best(f32x16), best(f64x16)) } else { (best(f32x8), best(f64x8)) };
         let divider = |division: fn(u64) -> (u64, f64), root: fn(u64) -> (u64, f64)| Divider {
-            division: best_of(division, DIVIDER_ROUNDS),
-            root: best_of(root, DIVIDER_ROUNDS),
+            division: best_of(division, DIVIDER_ROUNDS, passes),
+            root: best_of(root, DIVIDER_ROUNDS, passes),
         };
         let (simd_f32_divider, simd_f64_divider) = if sixteen {
             (divider(div_f32x16, sqrt_f32x16), divider(div_f64x16, sqrt_f64x16))
@@ -68,14 +74,10 @@ impl Peak {
 /// Rounds of a timed division or square root pass: those run about a tenth as fast as multiplies and adds.
 const DIVIDER_ROUNDS: u64 = ROUNDS / 8;
 
-/// The best rate of `run` over 5 passes.
-fn best(run: fn(u64) -> (u64, f64)) -> f64 {
-    best_of(run, ROUNDS)
-}
-
-fn best_of(run: fn(u64) -> (u64, f64), rounds: u64) -> f64 {
+/// The best rate of `run` over `passes` passes of `rounds` rounds.
+fn best_of(run: fn(u64) -> (u64, f64), rounds: u64, passes: usize) -> f64 {
     let mut best = 0.0f64;
-    for _ in 0..5 {
+    for _ in 0..passes {
         let start = Instant::now();
         let (operations, value) = run(black_box(rounds));
         black_box(value);

@@ -188,8 +188,8 @@ fn paired_rounds(mut a: &mut dyn FnMut(), mut b: &mut dyn FnMut(), rounds: usize
 }
 
 /// The lane solver's time per joint and substep against the lower bound measured alongside it: each round
-/// measures the arithmetic peaks (best of two passes each) and then times a block of frames, or the other way
-/// round, so that both see the same clock. This VM's clock moves within a run: the rounds' bounds range by a
+/// measures the arithmetic peaks (best of two passes each) and then times a block of frames (their median), or
+/// the other way round, so that both see the same clock. This VM's clock moves within a run: the rounds' bounds range by a
 /// fifth and more (the report prints the range), so a peak measured once at the start, against frame medians
 /// taken minutes later, moves the ratio by as much.
 pub struct BoundRatio {
@@ -217,14 +217,17 @@ pub fn interleaved_bound_ratio(
     let start = Instant::now();
     let substeps_per_frame = f64::from(frame().max(1));
     let frames = ((block.as_secs_f64() / start.elapsed().as_secs_f64().max(1e-9)).ceil() as u64).max(1);
-    // Seconds per joint and substep over one block of frames.
+    // Seconds per joint and substep over one block of frames: the median frame, as the peaks take their best
+    // pass, so that another process's time slice in the block moves neither.
     let mut time_frames = || {
-        let mut substeps = 0u64;
-        let start = Instant::now();
-        for _ in 0..frames {
-            substeps += u64::from(frame());
-        }
-        start.elapsed().as_secs_f64() / (substeps.max(1) as f64 * dynamic_joints)
+        let per_frame = (0..frames)
+            .map(|_| {
+                let start = Instant::now();
+                let substeps = frame().max(1);
+                start.elapsed().as_secs_f64() / (f64::from(substeps) * dynamic_joints)
+            })
+            .collect();
+        median(per_frame)
     };
     let bound = || Bound::at(Peak::measure_with(sixteen, 2), bandwidth, substeps_per_frame).lanes();
     let (mut measured, mut bounds) = (Vec::new(), Vec::new());
@@ -945,9 +948,9 @@ impl Report {
                 md,
                 "Measured with the bound: the ratios above divide frame medians by a bound whose peaks were \
                  measured once, before the scenes, at whatever clock the core ran then. Measured together, round \
-                 by round (the peaks, best of two passes each, then a block of 1000 x 16 plain frames, or the other \
-                 way round; {} rounds), the lane solver took {:.0} ns/joint/substep against a bound of {:.1} \
-                 (medians; the rounds' bounds ranged from {:.1} to {:.1}): **{:.1}x**, the median of the rounds' \
+                 by round (the peaks, best of two passes each, then the median of a block of 1000 x 16 plain \
+                 frames, or the other way round; {} rounds), the lane solver took {:.0} ns/joint/substep against a \
+                 bound of {:.1} (medians; the rounds' bounds ranged from {:.1} to {:.1}): **{:.1}x**, the median of the rounds' \
                  own ratios. The target's verdict uses this ratio.\n\n",
                 b.rounds,
                 b.measured * 1e9,

@@ -345,9 +345,11 @@ pub struct Work {
 ///
 /// The divisions and square roots run on a divider that takes a new operation only every few cycles, so the
 /// bound prices them at their own measured rates (`Peak`'s dividers), not at the multiplies' and adds'.
-/// `tools/divider_ops.py` counts what runs, from callgrind: on `scene_cost 20 1000x16` (built at 9acea66) 14.37
-/// single-precision divisions, 7.47 square roots and 10.74 double-precision divisions per joint per substep,
-/// above the minimums counted here (second polar passes, second forward passes).
+/// `tools/arithmetic_ops.py` counts what runs, from callgrind: on `scene_cost 20 1000x16` (built at 1b3bce5) 1 513
+/// single- and 417 double-precision operations per joint per substep, among them 14.37 single-precision
+/// divisions, 7.47 square roots and 10.74 double-precision divisions, above the minimums counted here: second
+/// polar passes, and 2.6 forward passes per inextensibility solve on average (every lane of a group runs the
+/// passes its slowest lane needs).
 pub const SUBSTEP_WORK: [Work; 5] = [
     // Velocity relative to the root, decay and gravity (15), angular decay (3), position predict (3 f32, 3
     // f64), orientation predict: scaled turn (3), exponential (26), product (28), normalise (13).

@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
-"""Divisions and square roots executed per dynamic joint per substep, in lane operations (a 256-bit `vdivps`
-counts 8, a `vdivpd` 4, a scalar `divss` 1): the check on the division and square-root counts of `SUBSTEP_WORK` in
-`benches/support/perf_report.rs`, which are minimums and so must not exceed what runs. Runs `scene_cost` under
-callgrind for FRAMES frames and for none (the setup alone) and takes the difference.
+"""Floating-point operations executed per dynamic joint per substep, in lane operations (a 256-bit `vmulps`
+counts 8, a `vmulpd` 4, a scalar `mulss` 1), by kind and precision: the check on the operation counts of
+`SUBSTEP_WORK` in `benches/support/perf_report.rs` (its divisions and square roots, and its totals of adds,
+subtracts, multiplies, divisions and square roots), which are minimums and so must not exceed what runs. Runs
+`scene_cost` under callgrind for FRAMES frames and for none (the setup alone) and takes the difference.
 
-    python3 tools/divider_ops.py target/release/examples/scene_cost 20 1000x16
+    python3 tools/arithmetic_ops.py target/release/examples/scene_cost 20 1000x16
 
-Lanes the kernel pads (a group's spare lanes) count too. Needs valgrind and objdump (Linux, x86-64).
+Lanes the kernel pads (a group's spare lanes) count too; what the counting rule leaves out (comparisons,
+selects, conversions, signs and absolute values) is not counted here either. Needs valgrind and objdump (Linux,
+x86-64).
 """
 
 import collections
@@ -16,11 +19,11 @@ import subprocess
 import sys
 import tempfile
 
-OPERATION = re.compile(r"v?(div|sqrt)(ps|pd|ss|sd)$")
+OPERATION = re.compile(r"v?(add|sub|mul|div|sqrt)(ps|pd|ss|sd)$")
 
 
 def lanes(mnemonic, operands):
-    """Lane operations of one execution of a division or square root."""
+    """Lane operations of one execution of an arithmetic instruction."""
     suffix = mnemonic[-2:]
     if suffix in ("ss", "sd"):
         return 1
@@ -28,8 +31,8 @@ def lanes(mnemonic, operands):
     return bits // (32 if suffix == "ps" else 64)
 
 
-def dividers(binary):
-    """Address -> (kind, lanes) of every division and square root in the binary."""
+def arithmetic(binary):
+    """Address -> (kind, lanes) of every add, subtract, multiply, division and square root in the binary."""
     found = {}
     listing = subprocess.run(["objdump", "-d", "--no-show-raw-insn", binary], capture_output=True, text=True,
                              check=True).stdout
@@ -70,7 +73,7 @@ def main():
         sys.exit(__doc__)
     binary, frames, scene = sys.argv[1], int(sys.argv[2]), sys.argv[3]
     joints, chains = {"1000x16": (16, 1000), "100x16": (16, 100)}[scene]
-    found = dividers(binary)
+    found = arithmetic(binary)
     run, setup = executed(binary, [str(frames), scene]), executed(binary, ["0", scene])
     totals = collections.Counter()
     for address, (kind, width) in found.items():
@@ -79,6 +82,9 @@ def main():
     joint_substeps = frames * 4 * chains * (joints - 1)
     for kind in sorted(totals):
         print(f"{kind}: {totals[kind] / joint_substeps:.2f} lane operations per joint per substep")
+    for precision in ("f32", "f64"):
+        total = sum(n for kind, n in totals.items() if kind.endswith(precision))
+        print(f"all {precision}: {total / joint_substeps:.2f} lane operations per joint per substep")
 
 
 if __name__ == "__main__":

@@ -55,14 +55,16 @@ struct Strand {
 }
 
 /// Chains of every kind: 12 stiff-ish chains of 8 joints (a lane group of 8 and one of 4), 4 limp chains of 5
-/// joints (a limp group of 4: no shape matching), 5 chains of 16 joints (a group of 8 with 3 spare lanes) and
-/// single chains of 2, 3 and 20 joints (the scalar solver), with and without view shapes.
+/// joints (a limp group of 4: no shape matching), 5 chains of 16 joints (a group of 8 with 3 spare lanes), 4
+/// chains of 2 joints (a group of 4 whose direct solve has a single bond, both the first and the last) and
+/// single chains of 3 and 20 joints (the scalar solver), with and without view shapes.
 fn strands() -> Vec<Strand> {
     let mut kinds: Vec<(usize, f32)> = Vec::new();
     kinds.extend((0..12).map(|i| (8, [0.3, 0.5, 0.8, 1.0][i % 4])));
     kinds.extend((0..4).map(|_| (5, 0.0)));
     kinds.extend((0..5).map(|i| (16, [0.2, 0.5, 0.7, 0.9, 0.4][i])));
-    kinds.extend([(2, 0.5), (3, 0.0), (20, 0.6)]);
+    kinds.extend((0..4).map(|i| (2, [0.3, 0.5, 0.8, 1.0][i])));
+    kinds.extend([(3, 0.0), (20, 0.6)]);
     kinds
         .into_iter()
         .enumerate()
@@ -81,7 +83,9 @@ fn strands() -> Vec<Strand> {
 
 /// The chains the lane solver takes from [`strands`]: all but the last 1 or 2 of a joint count after its groups
 /// of 8 (the five 16-joint chains run as a group of 8 with three spare lanes).
-const STRANDS_IN_LANES: u32 = 12 + 4 + 5;
+const STRANDS_IN_LANES: u32 = 12 + 4 + 5 + 4;
+/// The two-joint chains among them.
+const TWO_JOINT_STRANDS: u32 = 4;
 
 fn build(solver: Solver, strands: &[Strand], with_colliders: bool) -> (Engine, Vec<(ChainId, f32)>) {
     let (mut engine, ids) = build_with_subject_at(strands, usize::MAX, solver);
@@ -92,14 +96,14 @@ fn build(solver: Solver, strands: &[Strand], with_colliders: bool) -> (Engine, V
 }
 
 /// Largest distance between the two engines' joints, per chain length, over `frames`, checked every frame.
-fn largest_difference(strands: &[Strand], frames: usize, with_colliders: bool) -> f32 {
+fn largest_difference(strands: &[Strand], in_lanes: u32, frames: usize, with_colliders: bool) -> f32 {
     let (mut lanes, ids) = build(Solver::Lanes, strands, with_colliders);
     let (mut scalar, scalar_ids) = build(Solver::Scalar, strands, with_colliders);
     let mut worst = 0.0f32;
     for frame in 0..frames {
         drive(&mut lanes, frame..frame + 1);
         drive(&mut scalar, frame..frame + 1);
-        assert_eq!(lanes.stats().lane_chains, STRANDS_IN_LANES, "frame {frame}");
+        assert_eq!(lanes.stats().lane_chains, in_lanes, "frame {frame}");
         assert_same_work(&lanes, &scalar, frame);
         // Limp chains have no shape matching, so both solvers compute the very same positions (the root's
         // orientation, anchor times rest, is multiplied in a different order).
@@ -137,7 +141,7 @@ fn assert_same_work(lanes: &Engine, scalar: &Engine, frame: usize) {
 #[test]
 fn lane_solver_matches_the_scalar_solver() {
     let strands = strands();
-    let worst = largest_difference(&strands, 60, false);
+    let worst = largest_difference(&strands, STRANDS_IN_LANES, 60, false);
     println!(
         "lane vs scalar solver, 1 s of swaying, {} chains ({STRANDS_IN_LANES} in lanes): largest joint distance {worst:.2e} chain lengths",
         strands.len()
@@ -150,9 +154,12 @@ fn lane_solver_matches_the_scalar_solver() {
 #[test]
 fn lane_solver_matches_the_scalar_solver_with_colliders() {
     // Thin strands (8 to 12 mm joints, three frictions), so that no joint next to a root is buried in the head
-    // sphere, where no contact can be resolved and rounding differences grow without bound.
+    // sphere, where no contact can be resolved and rounding differences grow without bound. Without the
+    // two-joint chains, whose one moving joint is next to its root: on one of them (of 0.03 m) the solvers'
+    // difference grows from rounding at frame 2 to a fifth of its length by frame 41 as it rides the sphere.
     let strands: Vec<Strand> = strands()
         .into_iter()
+        .filter(|s| s.joints != 2)
         .enumerate()
         .map(|(i, s)| {
             let radius = 0.008 + 0.0002 * i as f32;
@@ -160,7 +167,7 @@ fn lane_solver_matches_the_scalar_solver_with_colliders() {
             Strand { params: ChainParams { radius, friction, ..s.params }, ..s }
         })
         .collect();
-    let worst = largest_difference(&strands, 60, true);
+    let worst = largest_difference(&strands, STRANDS_IN_LANES - TWO_JOINT_STRANDS, 60, true);
     // The colliders matter: without them the strands end up elsewhere.
     let (mut with, ids) = build(Solver::Lanes, &strands, true);
     let (mut without, without_ids) = build(Solver::Lanes, &strands, false);

@@ -163,8 +163,7 @@ fn paired_rounds(mut a: &mut dyn FnMut(), mut b: &mut dyn FnMut(), rounds: usize
     // Calibrate the block length on the slower of the two (after one warm frame each).
     once(&mut a);
     once(&mut b);
-    let frame = once(&mut a).max(once(&mut b)).max(1e-9);
-    let frames = ((block.as_secs_f64() / frame).ceil() as u64).max(1);
+    let frames = frames_per_block(once(&mut a).max(once(&mut b)), block);
     let run = |f: &mut dyn FnMut()| {
         let start = Instant::now();
         for _ in 0..frames {
@@ -216,7 +215,7 @@ pub fn interleaved_bound_ratio(
     frame();
     let start = Instant::now();
     let substeps_per_frame = f64::from(frame().max(1));
-    let frames = ((block.as_secs_f64() / start.elapsed().as_secs_f64().max(1e-9)).ceil() as u64).max(1);
+    let frames = frames_per_block(start.elapsed().as_secs_f64(), block);
     // Seconds per joint and substep over one block of frames: the median frame, as the peaks take their best
     // pass, so that another process's time slice in the block moves neither.
     let mut time_frames = || {
@@ -245,6 +244,11 @@ pub fn interleaved_bound_ratio(
     let ratios = measured.iter().zip(&bounds).map(|(m, b)| m / b).collect();
     let bound_range = bounds.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &b| (lo.min(b), hi.max(b)));
     BoundRatio { ratio: median(ratios), measured: median(measured), bound: median(bounds), bound_range, rounds }
+}
+
+/// Frames of `frame_seconds` each that fill a block of about `block`.
+fn frames_per_block(frame_seconds: f64, block: Duration) -> u64 {
+    ((block.as_secs_f64() / frame_seconds.max(1e-9)).ceil() as u64).max(1)
 }
 
 // ---- the machine ----------------------------------------------------------------------------------------
@@ -348,7 +352,8 @@ pub struct Work {
 /// `tools/arithmetic_ops.py` counts what runs, from callgrind: on `scene_cost 20 1000x16` (built at 1b3bce5) 1 513
 /// single- and 417 double-precision operations per joint per substep, among them 14.37 single-precision
 /// divisions, 7.47 square roots and 10.74 double-precision divisions, above the minimums counted here: second
-/// polar passes, and 2.6 forward passes per inextensibility solve on average (nearly every lane needs the second
+/// polar passes, and 2.6 forward passes per inextensibility solve on average (the calls of `first_pass8` and
+/// `corrected_pass8` in the callgrind of `scene_cost 20 1000x16 lanes`; nearly every lane needs the second
 /// and many a third: counted with a temporary counter in a build not in the repository).
 pub const SUBSTEP_WORK: [Work; 5] = [
     // Velocity relative to the root, decay and gravity (15), angular decay (3), position predict (3 f32, 3

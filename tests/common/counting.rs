@@ -3,8 +3,7 @@
 //! performance report (`benches/support/perf_report.rs`) includes this file for its allocations per frame.
 //!
 //! Per thread, because the test harness's main thread allocates too while it sets up its wait for the test's
-//! thread (a channel receive with a timeout: 3 allocations across the two threads in a standalone program
-//! with a counting allocator). Counted process-wide, those fell into a counted frame whenever the main thread
+//! thread (std's channel receive with a timeout allocates). Counted process-wide, those fell into a counted frame whenever the main thread
 //! got there late on a loaded machine: `tests/no_alloc_changes.rs` failed once in a full `cargo test --release`
 //! run and passed on every rerun. What is counted is what the calling thread allocates, which is all a step
 //! does: the engine starts no threads (the `parallel` feature's batch call does, and the tests leave its

@@ -8,6 +8,7 @@ use glam::{DVec3, Vec3};
 
 use super::buffers::reserve_total;
 use super::implicit::{self, ImplicitScratch};
+use super::warm_start::{MultiplierHistory, WARM_SLOTS};
 
 /// Relative error of `|b|^2 / l^2 - 1` below which a bond counts as satisfied: 5e-8 in length, the float32
 /// floor (a chain's lengths are float32, so they are known to 6e-8 of themselves; the render pose is float32).
@@ -119,10 +120,51 @@ fn solve_direct(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> 
     let m = lengths.len();
     debug_assert!(p.len() == m + 1 && s.start_bonds.len() >= m);
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
-    if newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton) {
+    if newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, Start::Cold) {
         return Solved::Direct;
     }
     fall_back(p, lengths, s)
+}
+
+/// [`solve_direct`] from the multipliers `history` extrapolates ([`super::warm_start`]), or from none if it
+/// remembers none; `history` learns how it ended.
+fn solve_warm(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, history: &mut MultiplierHistory) -> Solved {
+    let m = lengths.len();
+    debug_assert!(p.len() == m + 1 && s.start_bonds.len() >= m);
+    let start = if history.remembered() {
+        history.write_start(&mut s.newton.mu[..m]);
+        Start::Warm
+    } else {
+        Start::Cold
+    };
+    let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
+    let solved = if newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, start) {
+        Solved::Direct
+    } else {
+        fall_back(p, lengths, s)
+    };
+    if solved == Solved::Direct {
+        history.learn(&s.newton.mu[..m]);
+    } else {
+        history.forget();
+    }
+    solved
+}
+
+/// [`solve_prepared`] for the solve after iteration `iteration` (from 1) of a substep's shape matching: from
+/// the multipliers the same solve ended with in the last substeps, where it has a slot of the chain's
+/// `memory` ([`super::warm_start`]). Returns `false` when the direct solve failed (a fallback ran).
+pub fn solve_again(
+    p: &mut [DVec3],
+    lengths: &[f32],
+    s: &mut ConstraintScratch,
+    memory: &mut SolveMemory,
+    iteration: usize,
+) -> bool {
+    match memory.warm.get_mut(iteration) {
+        Some(history) if history.last.len() == lengths.len() => solve_warm(p, lengths, s, history) == Solved::Direct,
+        _ => solve_prepared(p, lengths, s),
+    }
 }
 
 /// [`solve_prepared`] for a contact round that ends a substep where some particles slide on a collider: a
@@ -136,7 +178,7 @@ pub fn solve_sliding(p: &mut [DVec3], lengths: &[f32], normals: &[Vec3], s: &mut
     debug_assert!(p.len() == m + 1 && normals.len() == m + 1 && s.start_bonds.len() >= m);
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
     let sliding = Sliding(normals);
-    if newton_along_directions(p, &s.start_bonds[..m], &sliding, l2, inv_l2, &mut s.newton) {
+    if newton_along_directions(p, &s.start_bonds[..m], &sliding, l2, inv_l2, &mut s.newton, Start::Cold) {
         return true;
     }
     // The Gauss-Newton projection moves `p` as it goes: keep the given positions for the unrestricted solve.
@@ -190,6 +232,10 @@ pub struct SolveMemory {
     correction: Vec<DVec3>,
     /// Substeps in a row whose first solve took the exact projection.
     exact_streak: u32,
+    /// The direct solve's multipliers, one history per solve of a substep ([`super::warm_start`]), and the
+    /// substep length and iterations they were learnt at (another rate gives other multipliers).
+    pub(crate) warm: [MultiplierHistory; WARM_SLOTS],
+    learnt_at: (u32, u32),
 }
 
 /// A chain whose first solves keep taking the exact projection tries the direct solve again every this many
@@ -198,12 +244,38 @@ const RETRY_DIRECT: u32 = 8;
 
 impl SolveMemory {
     pub fn new(bonds: usize) -> Self {
-        Self { tension: vec![0.0; bonds], correction: vec![DVec3::ZERO; bonds + 1], exact_streak: 0 }
+        Self {
+            tension: vec![0.0; bonds],
+            correction: vec![DVec3::ZERO; bonds + 1],
+            exact_streak: 0,
+            warm: std::array::from_fn(|_| MultiplierHistory::new(bonds)),
+            learnt_at: (0, 0),
+        }
     }
 
     /// Forgets what was learnt (the chain was placed anew).
     pub fn forget(&mut self) {
         self.exact_streak = 0;
+        self.warm.iter_mut().for_each(MultiplierHistory::forget);
+    }
+
+    /// Before a substep of length `h` with `iterations` solves (one per iteration): the multipliers learnt
+    /// at another substep length or iteration count are forgotten, and so are those of solves this substep
+    /// does not run.
+    pub fn begin_substep(&mut self, h: f32, iterations: u32) {
+        if !self.warm_applies(h, iterations) {
+            self.warm.iter_mut().for_each(MultiplierHistory::forget);
+            self.set_learnt_at(h, iterations);
+        }
+    }
+
+    /// Whether the multiplier histories were learnt at substeps of length `h` with `iterations` solves.
+    pub(crate) fn warm_applies(&self, h: f32, iterations: u32) -> bool {
+        self.learnt_at == (h.to_bits(), iterations)
+    }
+
+    pub(crate) fn set_learnt_at(&mut self, h: f32, iterations: u32) {
+        self.learnt_at = (h.to_bits(), iterations);
     }
 
     /// The chain was carried rigidly by `rotation` (a teleport): the remembered corrections, world vectors,
@@ -220,7 +292,11 @@ impl SolveMemory {
         let (tension, correction) =
             if self.exact_streak > 0 { (&self.tension[..], &self.correction[..]) } else { (&[][..], &[][..]) };
         let correction = correction.iter().flat_map(|c| c.to_array()).map(f64::to_bits);
-        std::iter::once(self.exact_streak as u64).chain(tension.iter().map(|t| t.to_bits())).chain(correction)
+        let warm = self.warm.iter().flat_map(MultiplierHistory::words);
+        std::iter::once(self.exact_streak as u64)
+            .chain(tension.iter().map(|t| t.to_bits()))
+            .chain(correction)
+            .chain(warm)
     }
 }
 
@@ -230,9 +306,14 @@ impl SolveMemory {
 /// [`RETRY_DIRECT`]-th substep. Returns `false` when the direct solve was not used.
 pub fn solve_first(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, memory: &mut SolveMemory) -> bool {
     if exact_from_memory(p, lengths, s, memory) {
+        memory.warm[0].forget();
         return false;
     }
-    let solved = solve_direct(p, lengths, s);
+    let solved = if memory.warm[0].last.len() == lengths.len() {
+        solve_warm(p, lengths, s, &mut memory.warm[0])
+    } else {
+        solve_direct(p, lengths, s)
+    };
     memory.learn(solved, s, lengths.len());
     solved == Solved::Direct
 }
@@ -273,14 +354,14 @@ impl SolveMemory {
         }
     }
 
-    /// Room for a chain of `bonds` bonds, so that [`copy_from`](Self::copy_from) such a chain's memory does
+    /// Room for a chain of `bonds` bonds, so that [`copy_streak_from`](Self::copy_streak_from) such a chain's memory does
     /// not allocate.
     pub fn reserve(&mut self, bonds: usize) {
         reserve_total(&mut self.tension, bonds);
         reserve_total(&mut self.correction, bonds + 1);
     }
 
-    /// The most bonds a chain's memory can have for [`copy_from`](Self::copy_from) to fit without allocating.
+    /// The most bonds a chain's memory can have for [`copy_streak_from`](Self::copy_streak_from) to fit without allocating.
     #[cfg(test)]
     pub fn room(&self) -> usize {
         self.tension.capacity().min(self.correction.capacity().saturating_sub(1))
@@ -296,10 +377,12 @@ impl SolveMemory {
         !self.exact_streak.is_multiple_of(RETRY_DIRECT)
     }
 
-    /// `self = other`, in the room `self` has (no allocation once it has held a chain of that length). The
-    /// tensions and corrections are only read while the streak runs, and written before it starts, so they are copied only
-    /// then: most chains never fall back, and their memory costs a word.
-    pub fn copy_from(&mut self, other: &SolveMemory) {
+    /// The exact projection's part of `other` (its streak, tensions and corrections; not the multiplier
+    /// histories), in the room `self` has (no allocation once it has held a chain of that length): what a
+    /// lane group keeps per lane. The tensions and corrections are only read while the streak runs, and
+    /// written before it starts, so they are copied only then: most chains never fall back, and their
+    /// memory costs a word.
+    pub fn copy_streak_from(&mut self, other: &SolveMemory) {
         if other.exact_streak > 0 || self.tension.len() != other.tension.len() {
             self.tension.clear();
             self.tension.extend_from_slice(&other.tension);
@@ -388,7 +471,12 @@ fn project_relinearized(
             return false;
         }
         previous_worst = pass.worst;
-        if !pass.pivots_usable() || !back_substitute(c_prime, d_prime, mu, step, Update::Replace) {
+        if !pass.pivots_usable() {
+            return false;
+        }
+        // Each iteration's multipliers are a step of their own, from the bonds as they are now.
+        mu.fill(0.0);
+        if !back_substitute(c_prime, d_prime, mu, step) {
             return false;
         }
         for j in 1..=m {
@@ -398,9 +486,20 @@ fn project_relinearized(
     false
 }
 
+/// Where [`newton_along_directions`] starts.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Start {
+    /// From no multipliers.
+    Cold,
+    /// From the multipliers in the scratch's `mu` ([`super::warm_start`]); from none again if with them the
+    /// bonds are further off than without.
+    Warm,
+}
+
 /// Newton iterations on the multipliers `mu` of corrections along the directions `d` (one per bond):
 /// particle `j` moves by `d[j-1] mu[j-1] - d[j] mu[j]` (the root not at all), or by the part of that its
 /// `mobility` allows. Applies them to `p` and returns `true` when converged, leaves `p` untouched otherwise.
+/// On success `mu` holds the multipliers that moved `p` (none where the first pass found it converged).
 ///
 /// Each iteration is one pass root to tip that evaluates the bonds under the current multipliers and runs
 /// the forward elimination of the Thomas algorithm on the tridiagonal Newton system `J delta = -F/2`
@@ -414,16 +513,21 @@ fn newton_along_directions(
     length_squared: &[f64],
     inverse_length_squared: &[f64],
     s: &mut NewtonScratch,
+    start: Start,
 ) -> bool {
     let m = d.len();
     let p = &mut p[..m + 1];
     let (l2, inv_l2) = (&length_squared[..m], &inverse_length_squared[..m]);
     let (mu, corrected, step) = (&mut s.mu[..m], &mut s.corrected[..m + 1], &mut s.step[..m]);
     let (c_prime, d_prime) = (&mut s.c_prime[..m], &mut s.d_prime[..m]);
+    let warm = start == Start::Warm;
+    if !warm {
+        mu.fill(0.0);
+    }
     let mut previous_worst = f64::INFINITY;
     for iteration in 0..MAX_NEWTON_ITERATIONS {
         let mut pass = ForwardPass::default();
-        if iteration == 0 {
+        if iteration == 0 && !warm {
             // No corrections yet: the bonds of `p`.
             for k in 0..m {
                 pass.row(k, p[k + 1] - p[k], d, mobility, l2[k], inv_l2[k], c_prime, d_prime);
@@ -436,10 +540,16 @@ fn newton_along_directions(
             }
         }
         if pass.converged(previous_worst) {
-            if iteration > 0 {
+            if iteration > 0 || warm {
                 p[1..].copy_from_slice(&corrected[1..]);
             }
             return true;
+        }
+        if iteration == 0 && warm && above(pass.worst, TRUSTED_START) && above(pass.worst, largest_error(p, l2, inv_l2))
+        {
+            // The start is worse than none: the next pass, with no multipliers, is the cold start's first.
+            mu.fill(0.0);
+            continue;
         }
         if pass.diverging(previous_worst) {
             return false;
@@ -453,8 +563,7 @@ fn newton_along_directions(
             }
             return false;
         }
-        let update = if iteration == 0 { Update::Replace } else { Update::Add };
-        if !back_substitute(c_prime, d_prime, mu, step, update) {
+        if !back_substitute(c_prime, d_prime, mu, step) {
             return false;
         }
         if pass.worst <= LANDING_GATE && error_after_step(d, mobility, step, inv_l2) <= TOLERANCE {
@@ -466,6 +575,31 @@ fn newton_along_directions(
         }
     }
     false
+}
+
+/// A warm start whose first pass finds no bond error above this is kept without comparing it with no start (a
+/// cold start's first pass met 1e-2 to 1e-1 on the benchmark scenes' hair, and from errors up to this Newton's
+/// next pass meets about their square).
+pub(crate) const TRUSTED_START: f64 = 1e-2;
+
+/// Whether `error` is above `bound` or NaN.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+#[inline(always)]
+pub(crate) fn above(error: f64, bound: f64) -> bool {
+    !(error <= bound)
+}
+
+/// The largest relative bond error `|F_k| / l_k^2` of `p` (NaN if any is).
+fn largest_error(p: &[DVec3], l2: &[f64], inv_l2: &[f64]) -> f64 {
+    let mut worst = 0.0f64;
+    for k in 0..l2.len() {
+        let error = (((p[k + 1] - p[k]).length_squared() - l2[k]) * inv_l2[k]).abs();
+        // Unlike the passes' maximum, a NaN wins: a warm start must not beat it.
+        if error > worst || error.is_nan() {
+            worst = error;
+        }
+    }
+    worst
 }
 
 /// Errors above this are too large for one more step to land within [`TOLERANCE`], so the prediction is not
@@ -493,28 +627,18 @@ fn error_after_step(d: &[DVec3], mobility: &impl Mobility, step: &[f64], inv_l2:
     worst
 }
 
-/// How [`back_substitute`] writes its solution into the multipliers.
-#[derive(Clone, Copy, PartialEq)]
-enum Update {
-    Replace,
-    Add,
-}
-
 /// The Thomas algorithm's pass back: solves for the step from the forward elimination's `c_prime` and
-/// `d_prime` and replaces `mu` with it or adds it. Returns `false` if the step is not finite (the fallback's
-/// exact projection then starts from no multiplier where they are not finite).
+/// `d_prime` and adds it to `mu`. Returns `false` if the step is not finite (the fallback's exact projection
+/// then starts from no multiplier where they are not finite).
 #[inline]
-fn back_substitute(c_prime: &[f64], d_prime: &[f64], mu: &mut [f64], step: &mut [f64], update: Update) -> bool {
+fn back_substitute(c_prime: &[f64], d_prime: &[f64], mu: &mut [f64], step: &mut [f64]) -> bool {
     // A non-finite entry makes every later one non-finite (`x - c * inf` is infinite or NaN, `0 * inf` NaN),
     // so checking the last is enough.
     let mut next = 0.0f64;
     for k in (0..mu.len()).rev() {
         next = d_prime[k] - c_prime[k] * next;
         step[k] = next;
-        match update {
-            Update::Replace => mu[k] = next,
-            Update::Add => mu[k] += next,
-        }
+        mu[k] += next;
     }
     next.is_finite()
 }
@@ -677,7 +801,7 @@ mod tests {
         let (d, l2, inv_l2) =
             (s.start_bonds[..m].to_vec(), s.length_squared[..m].to_vec(), s.inverse_length_squared[..m].to_vec());
         let mut stepped = p.clone();
-        assert!(newton_along_directions(&mut stepped, &d, &Free, &l2, &inv_l2, &mut s.newton));
+        assert!(newton_along_directions(&mut stepped, &d, &Free, &l2, &inv_l2, &mut s.newton, Start::Cold));
         let measured = (0..m)
             .map(|k| (((stepped[k + 1] - stepped[k]).length_squared() - l2[k]) * inv_l2[k]).abs())
             .fold(0.0, f64::max);
@@ -685,6 +809,65 @@ mod tests {
         assert!(measured <= TOLERANCE, "{measured}");
         assert!((measured - predicted).abs() <= 1e-14, "{measured} vs {predicted}");
         assert!(predicted > 0.0);
+    }
+
+    /// A hanging chain's start `x`, `lengths` and prediction `p`, and its direct solve from no start: the
+    /// positions `cold` and the multipliers.
+    type HangingSolve = (Vec<DVec3>, Vec<f32>, Vec<DVec3>, Vec<DVec3>, Vec<f64>);
+
+    fn hanging_solve() -> HangingSolve {
+        let n = 16;
+        let x: Vec<DVec3> =
+            (0..n).map(|i| DVec3::new(0.02 * i as f64, -0.01 * i as f64, 0.003 * (i % 2) as f64)).collect();
+        let lengths: Vec<f32> = (0..n - 1).map(|k| (x[k + 1] - x[k]).length() as f32).collect();
+        let p: Vec<DVec3> = x
+            .iter()
+            .enumerate()
+            .map(|(i, v)| if i == 0 { *v } else { *v + DVec3::new(2e-4 * (i as f64).sin(), -1.7e-4, 0.0) })
+            .collect();
+        let mut s = ConstraintScratch::default();
+        prepare(&x, &lengths, &mut s);
+        let mut cold = p.clone();
+        let mut history = MultiplierHistory::new(n - 1);
+        assert_eq!(solve_warm(&mut cold, &lengths, &mut s, &mut history), Solved::Direct);
+        assert!(history.remembered());
+        (x, lengths, p, cold, history.last.clone())
+    }
+
+    /// From the multipliers that solved it, the same solve needs no Newton step: the first pass meets the
+    /// lengths and the positions are those multipliers' (within the tolerance of the cold answer).
+    #[test]
+    fn a_warm_start_at_the_answer_ends_in_its_first_pass() {
+        let (x, lengths, p, cold, multipliers) = hanging_solve();
+        let mut s = ConstraintScratch::default();
+        prepare(&x, &lengths, &mut s);
+        let mut history = MultiplierHistory::new(lengths.len());
+        history.learn(&multipliers);
+        let mut warm = p.clone();
+        assert_eq!(solve_warm(&mut warm, &lengths, &mut s, &mut history), Solved::Direct);
+        assert!(max_stretch(&warm, &lengths) < 1e-6, "{}", max_stretch(&warm, &lengths));
+        let apart = warm.iter().zip(&cold).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
+        assert!(apart < 1e-9, "{apart}");
+        // No step was taken: the history learnt the start itself.
+        assert_eq!(history.last, multipliers);
+    }
+
+    /// A start worse than none (multipliers of another chain, far off) is dropped after one pass: the solve
+    /// then computes exactly what it computes from no start, to the bit.
+    #[test]
+    fn a_warm_start_worse_than_none_gives_the_cold_answer() {
+        let (x, lengths, p, cold, multipliers) = hanging_solve();
+        let mut s = ConstraintScratch::default();
+        prepare(&x, &lengths, &mut s);
+        let mut history = MultiplierHistory::new(lengths.len());
+        let wrong: Vec<f64> = multipliers.iter().map(|mu| -40.0 * mu - 0.05).collect();
+        history.learn(&wrong);
+        let mut warm = p.clone();
+        assert_eq!(solve_warm(&mut warm, &lengths, &mut s, &mut history), Solved::Direct);
+        assert_eq!(warm, cold);
+        // What it learnt: the answer's multipliers, with the wrong ones as the one before.
+        assert_eq!(history.last, multipliers);
+        assert_eq!(history.before, wrong);
     }
 
     #[test]

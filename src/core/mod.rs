@@ -4,7 +4,8 @@
 //! - [`shape`]: shapes and their encoded form (SPEC 3.1)
 //! - [`weights`]: view direction and blend weights (3.2)
 //! - [`blend`]: blending encoded shapes (3.3)
-//! - [`polar`], [`rod`], [`inextensible`], [`implicit`]: the oriented-particle rod and its constraints (3.4)
+//! - [`polar`], [`rod`], [`inextensible`], [`warm_start`], [`implicit`]: the oriented-particle rod and its
+//!   constraints (3.4)
 //! - [`lanes`]: the same rod, chains of equal length side by side in SIMD lanes
 //! - [`collider`], [`collision`]: colliders and the contact pass (3.7)
 //! - [`batch`]: many engines in one call (optionally on a thread pool)
@@ -32,6 +33,7 @@ pub(crate) mod reach;
 pub mod rod;
 pub mod shape;
 pub mod sketch;
+pub mod warm_start;
 pub mod weights;
 
 pub use batch::step_engines;

@@ -228,6 +228,7 @@ pub fn substep(
 
     let alpha = input.constants.alpha_per_iteration;
     let iterations = if alpha > 0.0 { input.iterations.max(1) } else { 1 };
+    state.solve_memory.begin_substep(h, iterations);
     let mut report = SubstepReport::default();
     for iteration in 0..iterations {
         if alpha > 0.0 {
@@ -244,7 +245,7 @@ pub fn substep(
         let solved = if iteration == 0 {
             inextensible::solve_first(p, lengths, constraints, &mut state.solve_memory)
         } else {
-            inextensible::solve_prepared(p, lengths, constraints)
+            inextensible::solve_again(p, lengths, constraints, &mut state.solve_memory, iteration as usize)
         };
         report.fallback |= !solved;
         if let Some(contacts) = &input.contacts {

@@ -12,6 +12,7 @@ use crate::core::inextensible::{ConstraintScratch, SolveMemory};
 use crate::core::math::Transform;
 use crate::core::rod::{ChainConstants, RodState};
 use crate::core::shape::Shape;
+use crate::core::warm_start::WARM_SLOTS;
 
 /// What one chain brings to a lane group for one step.
 pub(crate) struct LaneChain<'a> {
@@ -73,6 +74,9 @@ pub struct LaneGroup<const L: usize> {
     pub(super) start_bonds: Vec<DV3<L>>,
     pub(super) corrected: Vec<DV3<L>>,
     pub(super) mu: Vec<D<L>>,
+    /// The direct solve's multiplier histories (`warm_start`), one per solve of a substep: each lane's
+    /// chain's `SolveMemory::warm`, loaded and stored with it.
+    pub(super) warm: [WarmLanes<L>; WARM_SLOTS],
     /// The direct solve's last Newton step of the multipliers.
     pub(super) step: Vec<D<L>>,
     pub(super) c_prime: Vec<D<L>>,
@@ -96,6 +100,14 @@ pub struct LaneGroup<const L: usize> {
     pub(super) memories: Vec<SolveMemory>,
     pub(super) constraints: ConstraintScratch,
     pub(super) segment_bounds: SegmentBounds,
+}
+
+/// `MultiplierHistory` on every lane.
+#[derive(Default)]
+pub struct WarmLanes<const L: usize> {
+    pub(super) last: Vec<D<L>>,
+    pub(super) before: Vec<D<L>>,
+    pub(super) remembered: Mask<L>,
 }
 
 impl<const L: usize> Default for V3<L> {
@@ -160,6 +172,10 @@ impl<const L: usize> LaneGroup<L> {
         ] {
             fit(v, n, D([0.0; L]));
         }
+        for warm in &mut self.warm {
+            fit(&mut warm.last, n, D([0.0; L]));
+            fit(&mut warm.before, n, D([0.0; L]));
+        }
         fit(&mut self.anchors, substeps, (V3::ZERO, zero_q));
         for v in [&mut self.local_previous, &mut self.local_current, &mut self.output] {
             fit(v, n, (V3::ZERO, zero_q));
@@ -193,22 +209,31 @@ impl<const L: usize> LaneGroup<L> {
     /// lane would write all of the group's buffers, more than the L1 cache holds at 16 lanes.
     pub(crate) fn load(&mut self, chains: &[LaneChain<'_>; L]) {
         let n = self.n;
+        // Every chain's arrays cut to `n` up front, so the loops below index them without bounds checks.
+        let states = chains.each_ref().map(|c| {
+            let st = c.state;
+            (&st.x[..n], &st.v[..n], &st.q[..n], &st.w[..n], &st.group_rotation[..n])
+        });
+        let rests = chains.each_ref().map(|c| (&c.bone_axes[..n], &c.rest.orientations[..n], &c.offsets[..n]));
+        let (x, v, q, w, group_rotation) =
+            (&mut self.x[..n], &mut self.v[..n], &mut self.q[..n], &mut self.w[..n], &mut self.group_rotation[..n]);
+        let (bone_axes, qbars, qbar_invs, offsets) =
+            (&mut self.bone_axes[..n], &mut self.qbar[..n], &mut self.qbar_inv[..n], &mut self.offsets[..n]);
         for j in 0..n {
-            for (lane, chain) in chains.iter().enumerate() {
-                let st = chain.state;
-                self.x[j].set(lane, st.x[j].to_array());
-                self.v[j].set(lane, st.v[j].to_array());
-                self.q[j].set(lane, st.q[j].to_array());
-                self.w[j].set(lane, st.w[j].to_array());
-                self.group_rotation[j].set(lane, st.group_rotation[j].to_array());
+            for (lane, st) in states.iter().enumerate() {
+                x[j].set(lane, st.0[j].to_array());
+                v[j].set(lane, st.1[j].to_array());
+                q[j].set(lane, st.2[j].to_array());
+                w[j].set(lane, st.3[j].to_array());
+                group_rotation[j].set(lane, st.4[j].to_array());
             }
-            for (lane, chain) in chains.iter().enumerate() {
-                self.bone_axes[j].set(lane, chain.bone_axes[j].to_array());
-                let qbar = chain.rest.orientations[j];
-                self.qbar[j].set(lane, qbar.to_array());
-                self.qbar_inv[j].set(lane, qbar.inverse().to_array());
-                let [a, b, c] = chain.offsets[j];
-                let offsets = &mut self.offsets[j];
+            for (lane, rest) in rests.iter().enumerate() {
+                bone_axes[j].set(lane, rest.0[j].to_array());
+                let qbar = rest.1[j];
+                qbars[j].set(lane, qbar.to_array());
+                qbar_invs[j].set(lane, qbar.inverse().to_array());
+                let [a, b, c] = rest.2[j];
+                let offsets = &mut offsets[j];
                 offsets[0].set(lane, a.to_array());
                 offsets[1].set(lane, b.to_array());
                 offsets[2].set(lane, c.to_array());
@@ -242,7 +267,37 @@ impl<const L: usize> LaneGroup<L> {
             self.gravity.set(lane, constants.gravity.to_array());
             self.orientation_weight.0[lane] = constants.orientation_weight;
             self.half_kick.0[lane] = chain.half_kick;
-            self.memories[lane].copy_from(&chain.state.solve_memory);
+            self.memories[lane].copy_streak_from(&chain.state.solve_memory);
+        }
+        self.load_warm_starts(chains);
+    }
+
+    /// The solves of a substep, one per iteration.
+    fn solves(&self) -> u32 {
+        if self.shape_matching { self.iterations.max(1) } else { 1 }
+    }
+
+    /// The lanes' multiplier histories (`SolveMemory::warm`), as `rod::substep` reads them after its
+    /// `begin_substep` (every substep of the step has the group's length and iterations).
+    #[inline(never)]
+    fn load_warm_starts(&mut self, chains: &[LaneChain<'_>; L]) {
+        let bonds = self.n - 1;
+        let solves = self.solves();
+        for (lane, chain) in chains.iter().enumerate() {
+            let memory = &chain.state.solve_memory;
+            let applies = memory.warm_applies(self.h, solves);
+            for (warm, history) in self.warm.iter_mut().zip(&memory.warm) {
+                let remembered = applies && history.remembered() && history.last.len() == bonds;
+                warm.remembered.0[lane] = remembered;
+                if remembered {
+                    for (to, &from) in warm.last[..bonds].iter_mut().zip(&history.last) {
+                        to.0[lane] = from;
+                    }
+                    for (to, &from) in warm.before[..bonds].iter_mut().zip(&history.before) {
+                        to.0[lane] = from;
+                    }
+                }
+            }
         }
     }
 
@@ -294,14 +349,40 @@ impl<const L: usize> LaneGroup<L> {
 
     /// The particle state of `lane` into `state`.
     pub(crate) fn store(&self, lane: usize, state: &mut RodState) {
-        for j in 0..self.n {
-            state.x[j] = DVec3::from_array(self.x[j].get(lane));
-            state.q[j] = Quat::from_array(self.q[j].get(lane));
-            state.v[j] = Vec3::from_array(self.v[j].get(lane));
-            state.w[j] = Vec3::from_array(self.w[j].get(lane));
-            state.group_rotation[j] = Quat::from_array(self.group_rotation[j].get(lane));
+        let n = self.n;
+        // Cut to `n` up front: no bounds checks in the loop.
+        let (x, q, v, w, group_rotation) = (
+            &mut state.x[..n],
+            &mut state.q[..n],
+            &mut state.v[..n],
+            &mut state.w[..n],
+            &mut state.group_rotation[..n],
+        );
+        let (lane_x, lane_q, lane_v, lane_w, lane_rotation) =
+            (&self.x[..n], &self.q[..n], &self.v[..n], &self.w[..n], &self.group_rotation[..n]);
+        for j in 0..n {
+            x[j] = DVec3::from_array(lane_x[j].get(lane));
+            q[j] = Quat::from_array(lane_q[j].get(lane));
+            v[j] = Vec3::from_array(lane_v[j].get(lane));
+            w[j] = Vec3::from_array(lane_w[j].get(lane));
+            group_rotation[j] = Quat::from_array(lane_rotation[j].get(lane));
         }
-        state.solve_memory.copy_from(&self.memories[lane]);
+        let memory = &mut state.solve_memory;
+        memory.copy_streak_from(&self.memories[lane]);
+        memory.set_learnt_at(self.h, self.solves());
+        for (warm, history) in self.warm.iter().zip(&mut memory.warm) {
+            if warm.remembered.0[lane] && history.last.len() == self.n - 1 {
+                for (to, from) in history.last.iter_mut().zip(&warm.last) {
+                    *to = from.0[lane];
+                }
+                for (to, from) in history.before.iter_mut().zip(&warm.before) {
+                    *to = from.0[lane];
+                }
+                history.remembered = true;
+            } else {
+                history.forget();
+            }
+        }
     }
 
     /// The render poses of `lane` (`lanes::output`) into its chain's buffers.

@@ -12,6 +12,7 @@ use super::rotations::{Predict, Spin, angular_velocities, predict_orientations};
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
 use crate::core::inextensible::{self, SolveMemory, Solved};
 use crate::core::rod::FINAL_CONTACT_ROUNDS;
+use crate::core::warm_start::WARM_SLOTS;
 
 /// The vector phases of a substep, each compiled as its own function (a copy per instruction set:
 /// `mod.rs`). One function holding the whole substep is too large for the compiler's vectoriser: it split
@@ -20,7 +21,8 @@ use crate::core::rod::FINAL_CONTACT_ROUNDS;
 pub struct Phases<const L: usize> {
     pub begin: fn(&mut LaneGroup<L>, usize),
     pub match_shape: fn(&mut LaneGroup<L>),
-    pub solve_lengths: fn(&mut LaneGroup<L>, Mask<L>) -> Mask<L>,
+    /// The direct solve on some lanes, from a multiplier history (a slot of `LaneGroup::warm`) or none.
+    pub solve_lengths: fn(&mut LaneGroup<L>, Mask<L>, Option<usize>) -> Mask<L>,
     pub finish: fn(&mut LaneGroup<L>),
     /// The render pose: the capture after substep `s`, and the output at fraction `t` ([`output`]).
     pub capture: fn(&mut LaneGroup<L>, usize),
@@ -32,7 +34,7 @@ impl<const L: usize> Phases<L> {
     pub const PORTABLE: Self = Self {
         begin: |g, s| begin_substep(g, s, predict_orientations),
         match_shape: |g| match_shape(g, super::polar::extract_rotation),
-        solve_lengths: |g, lanes| solve_lengths(g, lanes, &Passes::PORTABLE),
+        solve_lengths: |g, lanes, warm| solve_lengths(g, lanes, warm, &Passes::PORTABLE),
         finish: |g| finish_substep(g, angular_velocities),
         capture: output::capture,
         output: output::write,
@@ -45,7 +47,7 @@ pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, phases: &Phases<L
     (phases.begin)(g, s);
     let mut fell_back = Mask([false; L]);
     for iteration in 0..iterations(g) {
-        fell_back = fell_back.or(iterate(g, phases, iteration == 0));
+        fell_back = fell_back.or(iterate(g, phases, iteration as usize));
     }
     (phases.finish)(g);
     fell_back
@@ -64,7 +66,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
     let mut fell_back = Mask([false; L]);
     let mut pairs = 0;
     for iteration in 0..iterations {
-        fell_back = fell_back.or(iterate(g, phases, iteration == 0));
+        fell_back = fell_back.or(iterate(g, phases, iteration as usize));
         pairs += contacts::collide(g, touching, true);
         start_bonds(g);
         if iteration + 1 == iterations {
@@ -78,7 +80,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
                 let sliding = contacts::sliding(g, again);
                 let vector = again.and(sliding.not());
                 if vector.any() {
-                    let solved = (phases.solve_lengths)(g, vector);
+                    let solved = (phases.solve_lengths)(g, vector, None);
                     let failed = vector.and(solved.not());
                     if failed.any() {
                         fell_back = fell_back.or(failed);
@@ -138,14 +140,15 @@ pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, predict: Pr
 /// One solver iteration: shape matching, then the lengths on every lane. Returns the lanes that fell back.
 /// The first iteration's solve is `inextensible::solve_first` on every lane: lanes whose chains' first
 /// solves have been taking the exact projection start with it, from their remembered tensions.
-fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>, first: bool) -> Mask<L> {
+fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>, iteration: usize) -> Mask<L> {
+    let first = iteration == 0;
     if g.shape_matching {
         (phases.match_shape)(g);
     }
     // Most groups have no lane that remembers anything.
     let remembering = first && g.memories.iter().any(SolveMemory::in_streak);
     let direct = if remembering { exact_from_memory(g) } else { Mask([true; L]) };
-    let solved = (phases.solve_lengths)(g, direct);
+    let solved = (phases.solve_lengths)(g, direct, (iteration < WARM_SLOTS).then_some(iteration));
     if remembering {
         for lane in (0..L).filter(|&lane| solved.0[lane]) {
             g.memories[lane].learn(Solved::Direct, &g.constraints, g.n - 1);

@@ -8,7 +8,10 @@
 
 use super::group::LaneGroup;
 use super::simd::{D, DV3, Mask};
-use crate::core::inextensible::{LANDING_GATE, MAX_NEWTON_ITERATIONS, MIN_PIVOT, STAGNATION_LIMIT, TOLERANCE};
+use crate::core::inextensible::{
+    LANDING_GATE, MAX_NEWTON_ITERATIONS, MIN_PIVOT, STAGNATION_LIMIT, TOLERANCE, TRUSTED_START,
+};
+use crate::core::warm_start::MultiplierHistory;
 
 type DVec = [f64; 3];
 
@@ -33,19 +36,43 @@ impl<const L: usize> Passes<L> {
     pub const PORTABLE: Self = Self { first: first_pass, corrected: corrected_pass };
 }
 
-/// The direct solve on the lanes of `lanes`; returns the lanes where it converged (their `p` holds the
-/// result; every other lane's `p` is untouched).
+/// The direct solve on the lanes of `lanes`, from the multiplier history `warm` (a slot of `g.warm`) or from
+/// none; returns the lanes where it converged (their `p` holds the result; every other lane's `p` is
+/// untouched), and the history learns from them (and forgets the lanes of `lanes` that failed).
 #[inline(always)]
-pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, passes: &Passes<L>) -> Mask<L> {
+pub fn solve_lengths<const L: usize>(
+    g: &mut LaneGroup<L>,
+    lanes: Mask<L>,
+    warm: Option<usize>,
+    passes: &Passes<L>,
+) -> Mask<L> {
     let m = g.n - 1;
+    // `inextensible::newton_along_directions` from `Start::Warm` on the lanes that remember multipliers, from
+    // `Start::Cold` on the others (their first pass, under no multipliers, computes the cold pass's values).
+    let started = warm.map_or(Mask([false; L]), |slot| g.warm[slot].remembered.and(lanes));
+    match warm {
+        Some(slot) if started.any() => {
+            let history = &g.warm[slot];
+            for k in 0..m {
+                let start = history.last[k].zip(history.before[k], MultiplierHistory::start);
+                g.mu[k] = D::select(started, start, D::select(lanes, D::splat(0.0), g.mu[k]));
+            }
+        }
+        _ => {
+            for mu in &mut g.mu[..m] {
+                *mu = D::select(lanes, D::splat(0.0), *mu);
+            }
+        }
+    }
     let mut active = lanes;
     let mut solved = Mask([false; L]);
     let mut previous_worst = D::splat(f64::INFINITY);
     for iteration in 0..MAX_NEWTON_ITERATIONS {
-        let pass = forward_pass(g, iteration > 0, passes);
+        let corrected = iteration > 0 || started.any();
+        let pass = forward_pass(g, corrected, passes);
         let converged = active.and(pass.converged(previous_worst));
         if converged.any() {
-            if iteration > 0 {
+            if corrected {
                 for j in 1..=m {
                     g.p[j] = DV3::select(converged, g.corrected[j], g.p[j]);
                 }
@@ -53,8 +80,23 @@ pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, passe
             solved = solved.or(converged);
             active = active.and(converged.not());
         }
-        active = active.and(pass.diverging(previous_worst).not()).and(pass.pivots_usable());
-        previous_worst = pass.worst;
+        // Lanes whose start is worse than none (`inextensible::TRUSTED_START`) start again: their next pass,
+        // under no multipliers, is the cold start's first (`le(..).not()`: a NaN error too).
+        let mut restart = Mask([false; L]);
+        if iteration == 0 {
+            let doubtful = active.and(started).and(pass.worst.le(D::splat(TRUSTED_START)).not());
+            if doubtful.any() {
+                restart = doubtful.and(pass.worst.le(largest_error(g, m)).not());
+            }
+        }
+        if restart.any() {
+            for mu in &mut g.mu[..m] {
+                *mu = D::select(restart, D::splat(0.0), *mu);
+            }
+        }
+        let stepping = active.and(restart.not());
+        active = active.and(restart.or(pass.diverging(previous_worst).not().and(pass.pivots_usable())));
+        previous_worst = D::select(restart, D::splat(f64::INFINITY), pass.worst);
         if iteration == 0 {
             // Lanes that fail before their first step keep no multipliers from an earlier solve (another
             // chain may have held the lane): their fallback starts from none, as on the scalar solver.
@@ -68,18 +110,18 @@ pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, passe
         if !active.any() {
             break;
         }
-        // Back substitution (the Thomas algorithm's pass back), into the multipliers of the active lanes.
+        // Back substitution (the Thomas algorithm's pass back), into the multipliers of the stepping lanes.
+        let stepping = stepping.and(active);
         let mut next = D::splat(0.0);
         for k in (0..m).rev() {
             next = g.d_prime[k] - g.c_prime[k] * next;
             g.step[k] = next;
-            let updated = if iteration == 0 { next } else { g.mu[k] + next };
-            g.mu[k] = D::select(active, updated, g.mu[k]);
+            g.mu[k] = D::select(stepping, g.mu[k] + next, g.mu[k]);
         }
-        active = active.and(next.is_finite());
+        active = active.and(restart.or(next.is_finite()));
         // `inextensible::error_after_step`: lanes whose step lands within the tolerance take its positions
         // without the pass that would confirm it.
-        let near = active.and(pass.worst.le(D::splat(LANDING_GATE)));
+        let near = stepping.and(active).and(pass.worst.le(D::splat(LANDING_GATE)));
         if near.any() {
             let landed = near.and(error_after_step(g, m).le(D::splat(TOLERANCE)));
             if landed.any() {
@@ -92,7 +134,39 @@ pub fn solve_lengths<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, passe
             break;
         }
     }
+    if let Some(slot) = warm {
+        learn(g, slot, m, solved);
+    }
     solved
+}
+
+/// `MultiplierHistory::learn` on the lanes of `solved`, `forget` on the others.
+#[inline(always)]
+fn learn<const L: usize>(g: &mut LaneGroup<L>, slot: usize, m: usize, solved: Mask<L>) {
+    let history = &mut g.warm[slot];
+    let remembered = history.remembered;
+    for k in 0..m {
+        let mu = g.mu[k];
+        history.before[k] = D::select(solved, D::select(remembered, history.last[k], mu), history.before[k]);
+        history.last[k] = D::select(solved, mu, history.last[k]);
+    }
+    history.remembered = solved;
+}
+
+/// `inextensible::largest_error` on every lane: the largest relative bond error of `p` (NaN if any is).
+#[inline(always)]
+fn largest_error<const L: usize>(g: &LaneGroup<L>, m: usize) -> D<L> {
+    let (p, l2, inv_l2) = (&g.p[..=m], &g.length_squared[..m], &g.inverse_length_squared[..m]);
+    let mut worst = [0.0; L];
+    for k in 0..m {
+        let (tip, start, l2, inv) = (&p[k + 1], &p[k], &l2[k], &inv_l2[k]);
+        for lane in 0..L {
+            let b = sub(tip.get(lane), start.get(lane));
+            let error = ((dot(b, b) - l2.0[lane]) * inv.0[lane]).abs();
+            worst[lane] = if error > worst[lane] || error.is_nan() { error } else { worst[lane] };
+        }
+    }
+    D(worst)
 }
 
 /// `inextensible::error_after_step` on every lane, from `g.step`. Lane by lane within each bond, as the passes:

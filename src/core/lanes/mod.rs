@@ -285,8 +285,8 @@ macro_rules! wide_phases {
         }
 
         #[multiversion(targets($target))]
-        fn $solve(g: &mut LaneGroup<$lanes>, lanes: Mask<$lanes>) -> Mask<$lanes> {
-            lengths::solve_lengths(g, lanes, &$passes)
+        fn $solve(g: &mut LaneGroup<$lanes>, lanes: Mask<$lanes>, warm: Option<usize>) -> Mask<$lanes> {
+            lengths::solve_lengths(g, lanes, warm, &$passes)
         }
 
         #[multiversion(targets($target))]

@@ -203,59 +203,60 @@ pub fn match_shape<const L: usize>(g: &mut LaneGroup<L>, polar: fn(&M3<L>, &mut 
     let alpha = g.alpha;
     let alpha64 = alpha.to_f64();
     let ow = g.orientation_weight;
+    // Every array cut to the joint count up front: the loop indexes them without bounds checks.
+    let (p, qp, qbar, qbar_inv) = (&mut g.p[..n], &mut g.qp[..n], &g.qbar[..n], &g.qbar_inv[..n]);
+    let (offsets, group_rotation) = (&g.offsets[..n], &mut g.group_rotation[..n]);
 
     // The root's group, clamped to the root.
-    let rotation = g.qp[0].mul(g.qbar_inv[0]).normalize();
-    g.group_rotation[1] = rotation;
-    let centre = g.p[0];
+    let rotation = qp[0].mul(qbar_inv[0]).normalize();
+    group_rotation[1] = rotation;
+    let centre = p[0];
     for j in 1..n.min(3) {
-        g.p[j] = pull_to_goal(g.p[j], centre, rotation.rotate(g.offsets[1][j]), alpha64);
+        p[j] = pull_to_goal(p[j], centre, rotation.rotate(offsets[1][j]), alpha64);
     }
-    g.qp[1] = g.qp[1].nlerp_shorter(rotation.mul(g.qbar[1]), alpha);
+    qp[1] = qp[1].nlerp_shorter(rotation.mul(qbar[1]), alpha);
 
     let mut carried: Option<M3<L>> = None;
     for i in 2..n {
         let lo = i - 1;
         let full = i + 1 < n;
-        let [r_lo, r_mid, r_hi] = g.offsets[i];
-        let m_lo = orientation_term(g, lo, ow);
-        let m_mid = carried.take().unwrap_or_else(|| orientation_term(g, i, ow));
+        let [r_lo, r_mid, r_hi] = offsets[i];
+        let m_lo = orientation_term(qp, qbar_inv, lo, ow);
+        let m_mid = carried.take().unwrap_or_else(|| orientation_term(qp, qbar_inv, i, ow));
         let (c, a) = if full {
             let hi = i + 1;
-            let m_hi = orientation_term(g, hi, ow);
+            let m_hi = orientation_term(qp, qbar_inv, hi, ow);
             carried = Some(m_hi);
-            let c = (DV3::ZERO + g.p[lo] + g.p[i] + g.p[hi]) / 3.0;
+            let c = (DV3::ZERO + p[lo] + p[i] + p[hi]) / 3.0;
             let a = m_lo
-                .add(M3::outer((g.p[lo] - c).to_f32(), r_lo))
+                .add(M3::outer((p[lo] - c).to_f32(), r_lo))
                 .add(m_mid)
-                .add(M3::outer((g.p[i] - c).to_f32(), r_mid))
+                .add(M3::outer((p[i] - c).to_f32(), r_mid))
                 .add(m_hi)
-                .add(M3::outer((g.p[hi] - c).to_f32(), r_hi));
+                .add(M3::outer((p[hi] - c).to_f32(), r_hi));
             (c, a)
         } else {
-            let c = (DV3::ZERO + g.p[lo] + g.p[i]) / 2.0;
-            let a = m_lo
-                .add(M3::outer((g.p[lo] - c).to_f32(), r_lo))
-                .add(m_mid)
-                .add(M3::outer((g.p[i] - c).to_f32(), r_mid));
+            let c = (DV3::ZERO + p[lo] + p[i]) / 2.0;
+            let a =
+                m_lo.add(M3::outer((p[lo] - c).to_f32(), r_lo)).add(m_mid).add(M3::outer((p[i] - c).to_f32(), r_mid));
             (c, a)
         };
-        let mut rotation = g.group_rotation[i];
+        let mut rotation = group_rotation[i];
         let frame = polar(&a, &mut rotation);
-        g.group_rotation[i] = rotation;
-        g.p[lo] = pull_to_goal(g.p[lo], c, frame.mul_vec3(r_lo), alpha64);
-        g.p[i] = pull_to_goal(g.p[i], c, frame.mul_vec3(r_mid), alpha64);
+        group_rotation[i] = rotation;
+        p[lo] = pull_to_goal(p[lo], c, frame.mul_vec3(r_lo), alpha64);
+        p[i] = pull_to_goal(p[i], c, frame.mul_vec3(r_mid), alpha64);
         if full {
-            g.p[i + 1] = pull_to_goal(g.p[i + 1], c, frame.mul_vec3(r_hi), alpha64);
+            p[i + 1] = pull_to_goal(p[i + 1], c, frame.mul_vec3(r_hi), alpha64);
         }
-        g.qp[i] = g.qp[i].nlerp_shorter(rotation.mul(g.qbar[i]), alpha);
+        qp[i] = qp[i].nlerp_shorter(rotation.mul(qbar[i]), alpha);
     }
 }
 
 /// A member's orientation term of the group matrix.
 #[inline(always)]
-fn orientation_term<const L: usize>(g: &LaneGroup<L>, j: usize, weight: F<L>) -> M3<L> {
-    M3::from_quat(g.qp[j].mul(g.qbar_inv[j])).scale(weight)
+fn orientation_term<const L: usize>(qp: &[Q<L>], qbar_inv: &[Q<L>], j: usize, weight: F<L>) -> M3<L> {
+    M3::from_quat(qp[j].mul(qbar_inv[j])).scale(weight)
 }
 
 #[inline(always)]

@@ -53,9 +53,9 @@ pub fn solve_lengths<const L: usize>(
     match warm {
         Some(slot) if started.any() => {
             let history = &g.warm[slot];
-            for k in 0..m {
-                let start = history.last[k].zip(history.before[k], MultiplierHistory::start);
-                g.mu[k] = D::select(started, start, D::select(lanes, D::splat(0.0), g.mu[k]));
+            for ((mu, &last), &before) in g.mu[..m].iter_mut().zip(&history.last[..m]).zip(&history.before[..m]) {
+                let start = last.zip(before, MultiplierHistory::start);
+                *mu = D::select(started, start, D::select(lanes, D::splat(0.0), *mu));
             }
         }
         _ => {
@@ -73,8 +73,8 @@ pub fn solve_lengths<const L: usize>(
         let converged = active.and(pass.converged(previous_worst));
         if converged.any() {
             if corrected {
-                for j in 1..=m {
-                    g.p[j] = DV3::select(converged, g.corrected[j], g.p[j]);
+                for (p, &corrected) in g.p[1..=m].iter_mut().zip(&g.corrected[1..=m]) {
+                    *p = DV3::select(converged, corrected, *p);
                 }
             }
             solved = solved.or(converged);
@@ -113,10 +113,11 @@ pub fn solve_lengths<const L: usize>(
         // Back substitution (the Thomas algorithm's pass back), into the multipliers of the stepping lanes.
         let stepping = stepping.and(active);
         let mut next = D::splat(0.0);
-        for k in (0..m).rev() {
-            next = g.d_prime[k] - g.c_prime[k] * next;
-            g.step[k] = next;
-            g.mu[k] = D::select(stepping, g.mu[k] + next, g.mu[k]);
+        let (c_prime, d_prime) = (&g.c_prime[..m], &g.d_prime[..m]);
+        for (((step, mu), &c), &d) in g.step[..m].iter_mut().zip(&mut g.mu[..m]).zip(c_prime).zip(d_prime).rev() {
+            next = d - c * next;
+            *step = next;
+            *mu = D::select(stepping, *mu + next, *mu);
         }
         active = active.and(restart.or(next.is_finite()));
         // `inextensible::error_after_step`: lanes whose step lands within the tolerance take its positions
@@ -145,10 +146,9 @@ pub fn solve_lengths<const L: usize>(
 fn learn<const L: usize>(g: &mut LaneGroup<L>, slot: usize, m: usize, solved: Mask<L>) {
     let history = &mut g.warm[slot];
     let remembered = history.remembered;
-    for k in 0..m {
-        let mu = g.mu[k];
-        history.before[k] = D::select(solved, D::select(remembered, history.last[k], mu), history.before[k]);
-        history.last[k] = D::select(solved, mu, history.last[k]);
+    for ((&mu, last), before) in g.mu[..m].iter().zip(&mut history.last[..m]).zip(&mut history.before[..m]) {
+        *before = D::select(solved, D::select(remembered, *last, mu), *before);
+        *last = D::select(solved, mu, *last);
     }
     history.remembered = solved;
 }
@@ -196,10 +196,11 @@ fn error_after_step<const L: usize>(g: &LaneGroup<L>, m: usize) -> D<L> {
 /// The positions under the multipliers on the lanes of `lanes`, as [`corrected_pass`] computes them.
 #[inline(always)]
 fn apply_multipliers<const L: usize>(g: &mut LaneGroup<L>, m: usize, lanes: Mask<L>) {
+    let (d, mu, p) = (&g.start_bonds[..m], &g.mu[..m], &mut g.p[1..=m]);
     for k in 0..m {
-        let pulled = g.start_bonds[k].scale(g.mu[k]);
-        let shift = if k + 1 < m { pulled - g.start_bonds[k + 1].scale(g.mu[k + 1]) } else { pulled };
-        g.p[k + 1] = DV3::select(lanes, g.p[k + 1] + shift, g.p[k + 1]);
+        let pulled = d[k].scale(mu[k]);
+        let shift = if k + 1 < m { pulled - d[k + 1].scale(mu[k + 1]) } else { pulled };
+        p[k] = DV3::select(lanes, p[k] + shift, p[k]);
     }
 }
 

@@ -396,7 +396,7 @@ fn bench_ffi(criterion: &mut Criterion, recorder: &Recorder, report: &mut Report
 }
 
 /// Fresh pairs of engines each C ABI ratio pools (`pooled_paired_ratio`).
-const FFI_PAIRS: usize = 8;
+const FFI_PAIRS: usize = 16;
 const FFI_NOISE_FLOOR: &str = "C ABI method's A/A control: two Rust engines, step_with_anchors + read_local_rotations";
 
 fn ffi_ratios(report: &mut Report) {

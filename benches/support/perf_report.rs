@@ -79,6 +79,8 @@ pub struct PairedRatio {
     /// For a ratio pooled over pairs of runs ([`pooled_paired_ratio`]): the smallest and largest of the pairs'
     /// own medians.
     pub pair_range: Option<(f64, f64)>,
+    /// The pairs of runs pooled (1 for [`paired_ratio`]).
+    pub pairs: usize,
 }
 
 /// Interleaves blocks of frames of `a` and `b` for `rounds` rounds; each block lasts about `block`.
@@ -123,7 +125,7 @@ pub fn pooled_paired_ratio(
         // Each pair's runs are dropped before the next pair's are made.
         drop((a, b));
     }
-    PairedRatio { pair_range: Some(pair_range), ..pooled.ratio(what, a_name, b_name) }
+    PairedRatio { pair_range: Some(pair_range), pairs, ..pooled.ratio(what, a_name, b_name) }
 }
 
 /// Seconds per frame of each round's block of A and of B.
@@ -150,6 +152,7 @@ impl RoundTimes {
             b_seconds: median(self.b),
             ratio: median(ratios),
             pair_range: None,
+            pairs: 1,
         }
     }
 }
@@ -784,8 +787,10 @@ impl Report {
         for (path, seconds) in &self.ffi {
             let _ = writeln!(md, "| {path} | {} |", micros(*seconds));
         }
-        md.push_str(
-            "\nInterleaved (the ratio the target uses), each ratio pooled over 8 pairs of engines made afresh, with the \
+        let pairs = self.paired.iter().find(|p| p.what.starts_with("C ABI")).map_or(0, |p| p.pairs);
+        let _ = write!(
+            md,
+            "\nInterleaved (the ratio the target uses), each ratio pooled over {pairs} pairs of engines made afresh, with the \
              method's A/A control. Where the allocator puts two engines' arrays shifts one of them by a few percent \
              for its whole life, so a single pair's ratio carries that shift (with one pair, the report of commit \
              b9b8ccf measured the C ABI at +6.0 % and +5.9 %); *pairs* gives the range of the pairs' own \

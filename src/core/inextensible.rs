@@ -138,11 +138,11 @@ fn solve_warm(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, histo
         Start::Cold
     };
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
-    let solved = if newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, start) {
-        Solved::Direct
-    } else {
-        fall_back(p, lengths, s)
-    };
+    let direct = newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, start)
+        // A warm start that failed tries again from none before the fallback, so that it never brings one on.
+        || (start == Start::Warm
+            && newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, Start::Cold));
+    let solved = if direct { Solved::Direct } else { fall_back(p, lengths, s) };
     if solved == Solved::Direct {
         history.learn(&s.newton.mu[..m]);
     } else {

@@ -58,12 +58,33 @@ pub fn solve_lengths<const L: usize>(
                 *mu = D::select(started, start, D::select(lanes, D::splat(0.0), *mu));
             }
         }
-        _ => {
-            for mu in &mut g.mu[..m] {
-                *mu = D::select(lanes, D::splat(0.0), *mu);
-            }
-        }
+        _ => zero_multipliers(g, m, lanes),
     }
+    let mut solved = newton(g, lanes, started, passes);
+    if let Some(slot) = warm {
+        // As `inextensible::solve_warm`: a warm start that failed tries again from none before the fallback.
+        let retry = started.and(solved.not());
+        if retry.any() {
+            zero_multipliers(g, m, retry);
+            solved = solved.or(newton(g, retry, Mask([false; L]), passes));
+        }
+        learn(g, slot, m, solved);
+    }
+    solved
+}
+
+#[inline(always)]
+fn zero_multipliers<const L: usize>(g: &mut LaneGroup<L>, m: usize, lanes: Mask<L>) {
+    for mu in &mut g.mu[..m] {
+        *mu = D::select(lanes, D::splat(0.0), *mu);
+    }
+}
+
+/// `inextensible::newton_along_directions` on the lanes of `lanes`, from the multipliers in `g.mu`: a warm start
+/// on the lanes of `started`, none on the others (whose multipliers are zero).
+#[inline(always)]
+fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>, passes: &Passes<L>) -> Mask<L> {
+    let m = g.n - 1;
     let mut active = lanes;
     let mut solved = Mask([false; L]);
     let mut previous_worst = D::splat(f64::INFINITY);
@@ -134,9 +155,6 @@ pub fn solve_lengths<const L: usize>(
         if !active.any() {
             break;
         }
-    }
-    if let Some(slot) = warm {
-        learn(g, slot, m, solved);
     }
     solved
 }

@@ -355,9 +355,9 @@ pub struct Work {
 /// `tools/arithmetic_ops.py` counts what runs, from callgrind: on `scene_cost 20 1000x16` (built at 1b3bce5) 1 513
 /// single- and 417 double-precision operations per joint per substep, among them 14.37 single-precision
 /// divisions, 7.47 square roots and 10.74 double-precision divisions, above the minimums counted here: second
-/// polar passes, and 2.6 forward passes per inextensibility solve on average (the calls of `first_pass8` and
-/// `corrected_pass8` in the callgrind of `scene_cost 20 1000x16 lanes`; nearly every lane needs the second
-/// and many a third: counted with a temporary counter in a build not in the repository).
+/// polar passes, and forward passes of the inextensibility solve beyond one: 2.64 per solve on average at
+/// 4bb5b3d, 1.43 since the warm start (`src/core/warm_start.rs`; the calls of `first_pass8` and
+/// `corrected_pass8` in the callgrind of `scene_cost 20 1000x16 lanes`).
 pub const SUBSTEP_WORK: [Work; 5] = [
     // Velocity relative to the root, decay and gravity (15), angular decay (3), position predict (3 f32, 3
     // f64), orientation predict: scaled turn (3), exponential (26), product (28), normalise (13).

@@ -834,17 +834,24 @@ mod tests {
         (x, lengths, p, cold, history.last.clone())
     }
 
+    /// The solve of `hanging_solve`'s prediction from a history that learnt `start`: the positions, the
+    /// history after it.
+    fn solve_from(x: &[DVec3], lengths: &[f32], p: &[DVec3], start: &[f64]) -> (Vec<DVec3>, MultiplierHistory) {
+        let mut s = ConstraintScratch::default();
+        prepare(x, lengths, &mut s);
+        let mut history = MultiplierHistory::new(lengths.len());
+        history.learn(start);
+        let mut warm = p.to_vec();
+        assert_eq!(solve_warm(&mut warm, lengths, &mut s, &mut history), Solved::Direct);
+        (warm, history)
+    }
+
     /// From the multipliers that solved it, the same solve needs no Newton step: the first pass meets the
     /// lengths and the positions are those multipliers' (within the tolerance of the cold answer).
     #[test]
     fn a_warm_start_at_the_answer_ends_in_its_first_pass() {
         let (x, lengths, p, cold, multipliers) = hanging_solve();
-        let mut s = ConstraintScratch::default();
-        prepare(&x, &lengths, &mut s);
-        let mut history = MultiplierHistory::new(lengths.len());
-        history.learn(&multipliers);
-        let mut warm = p.clone();
-        assert_eq!(solve_warm(&mut warm, &lengths, &mut s, &mut history), Solved::Direct);
+        let (warm, history) = solve_from(&x, &lengths, &p, &multipliers);
         assert!(max_stretch(&warm, &lengths) < 1e-6, "{}", max_stretch(&warm, &lengths));
         let apart = warm.iter().zip(&cold).map(|(a, b)| (*a - *b).length()).fold(0.0, f64::max);
         assert!(apart < 1e-9, "{apart}");
@@ -852,18 +859,13 @@ mod tests {
         assert_eq!(history.last, multipliers);
     }
 
-    /// A start worse than none (multipliers of another chain, far off) is dropped after one pass: the solve
-    /// then computes exactly what it computes from no start, to the bit.
+    /// A start worse than none (multipliers of another chain, far off) is dropped: the solve then computes
+    /// exactly what it computes from no start, to the bit.
     #[test]
     fn a_warm_start_worse_than_none_gives_the_cold_answer() {
         let (x, lengths, p, cold, multipliers) = hanging_solve();
-        let mut s = ConstraintScratch::default();
-        prepare(&x, &lengths, &mut s);
-        let mut history = MultiplierHistory::new(lengths.len());
         let wrong: Vec<f64> = multipliers.iter().map(|mu| -40.0 * mu - 0.05).collect();
-        history.learn(&wrong);
-        let mut warm = p.clone();
-        assert_eq!(solve_warm(&mut warm, &lengths, &mut s, &mut history), Solved::Direct);
+        let (warm, history) = solve_from(&x, &lengths, &p, &wrong);
         assert_eq!(warm, cold);
         // What it learnt: the answer's multipliers, with the wrong ones as the one before.
         assert_eq!(history.last, multipliers);

@@ -4,7 +4,7 @@
 use glam::{DVec3, Quat, Vec3, Vec3A};
 
 use super::contacts::LaneContacts;
-use super::simd::{D, DV3, F, Mask, Q, V3};
+use super::simd::{D, DV3, F, M3, Mask, Q, V3};
 use crate::core::buffers::reserve_total;
 use crate::core::collider::ColliderSweep;
 use crate::core::collision::SegmentBounds;
@@ -71,6 +71,8 @@ pub struct LaneGroup<const L: usize> {
     // Solver scratch.
     pub(super) p: Vec<DV3<L>>,
     pub(super) qp: Vec<Q<L>>,
+    /// Shape matching's orientation terms of the joints' predicted rotations (`kernel::match_shape`).
+    pub(super) orientation_terms: Vec<M3<L>>,
     pub(super) start_bonds: Vec<DV3<L>>,
     pub(super) corrected: Vec<DV3<L>>,
     pub(super) mu: Vec<D<L>>,
@@ -161,6 +163,8 @@ impl<const L: usize> LaneGroup<L> {
             fit(v, n, zero_q);
         }
         fit(&mut self.offsets, n, [V3::ZERO; 3]);
+        let zero_m = M3 { x_axis: V3::ZERO, y_axis: V3::ZERO, z_axis: V3::ZERO };
+        fit(&mut self.orientation_terms, n, zero_m);
         fit(&mut self.lengths, n, F([0.0; L]));
         for v in [
             &mut self.length_squared,

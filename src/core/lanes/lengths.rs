@@ -299,7 +299,10 @@ pub fn first_pass<const L: usize>(
     d_prime: &mut [D<L>],
     pass: &mut ForwardPass<L>,
 ) {
-    each_bond!(d.len(), |k, ends| {
+    let m = d.len();
+    // As in `corrected_pass`.
+    let (p, l2, inv_l2, c_prime, d_prime) = (&p[..=m], &l2[..m], &inv_l2[..m], &mut c_prime[..m], &mut d_prime[..m]);
+    each_bond!(m, |k, ends| {
         let bond = bond(k, ends, d, l2, inv_l2);
         let (tip, start) = (&p[k + 1], &p[k]);
         let (c_row, d_row) = (&mut c_prime[k], &mut d_prime[k]);
@@ -325,6 +328,10 @@ pub fn corrected_pass<const L: usize>(
     pass: &mut ForwardPass<L>,
 ) {
     let m = d.len();
+    // Every slice cut to its length up front: a bounds check in the loop would keep it scalar-stepped and make
+    // `pass` go back to memory at each bond (a panic there must see its fields).
+    let (p, corrected, mu, l2, inv_l2) = (&p[..=m], &mut corrected[..=m], &mu[..m], &l2[..m], &inv_l2[..m]);
+    let (c_prime, d_prime) = (&mut c_prime[..m], &mut d_prime[..m]);
     corrected[0] = p[0];
     each_bond!(m, |k, ends| {
         let bond = bond(k, ends, d, l2, inv_l2);

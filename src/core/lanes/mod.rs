@@ -47,7 +47,7 @@ use super::rod::ChainConstants;
 use group::{GroupSettings, LaneChain, LaneGroup};
 use kernel::Phases;
 use lengths::{ForwardPass, Passes};
-use simd::{D, DV3, M3, Mask, Q, V3};
+use simd::{D, DV3, F, M3, Mask, Q, V3};
 
 /// Which solver steps the chains.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -258,7 +258,7 @@ impl LaneSolver {
 
 /// The kernel's phases compiled for `$target` where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $polar:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
+    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $polar:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
         #[multiversion(targets($target))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
             kernel::begin_substep(g, s, $predict)
@@ -276,7 +276,12 @@ macro_rules! wide_phases {
 
         #[multiversion(targets($target))]
         fn $match_shape(g: &mut LaneGroup<$lanes>) {
-            kernel::match_shape(g, $polar)
+            kernel::match_shape(g, $polar, $terms)
+        }
+
+        #[multiversion(targets($target))]
+        fn $terms(qp: &[Q<$lanes>], qbar_inv: &[Q<$lanes>], weight: F<$lanes>, terms: &mut [M3<$lanes>]) {
+            kernel::orientation_terms(qp, qbar_inv, weight, terms)
         }
 
         #[multiversion(targets($target))]
@@ -353,6 +358,7 @@ wide_phases!(
     begin8,
     match_shape8,
     polar8,
+    terms8,
     solve_lengths8,
     PASSES8,
     first_pass8,
@@ -371,6 +377,7 @@ wide_phases!(
     begin16,
     match_shape16,
     polar16,
+    terms16,
     solve_lengths16,
     PASSES16,
     first_pass16,
@@ -388,6 +395,7 @@ wide_phases!(
     begin4,
     match_shape4,
     polar4,
+    terms4,
     solve_lengths4,
     PASSES4,
     first_pass4,

@@ -8,6 +8,14 @@ vector width. The figures in src/core/lanes/{polar,lengths}.rs come from it, e.g
 FUNCTION is the end of the function's demangled name. Prints the executed instructions of that function (not
 of its callees), split into 256-bit (ymm), 128-bit packed (xmm), scalar floating point (..ss/..sd) and other,
 and the share that reads or writes the stack. Needs valgrind and objdump (Linux, x86-64).
+
+With `--body MIN` before FUNCTION it prints instead the instructions of that function executed at least MIN
+times, in address order and without its branches and calls: the body of its hot loop, as `llvm-mca` reads it.
+For example, one group of shape matching's sweep (`scene_cost 20 1000x16` runs it 280 000 times):
+
+    python3 tools/instruction_mix.py --body 260000 match_shape8_avx2_version -- \\
+        target/release/examples/scene_cost 20 1000x16 lanes > /tmp/body.s
+    llvm-mca -mcpu=znver3 -iterations=100 /tmp/body.s
 """
 
 import collections
@@ -66,10 +74,25 @@ def executed(profile, start, end):
     return counts
 
 
+def print_body(code, counts, least):
+    """The instructions run at least `least` times, as assembly for llvm-mca: no branches, calls or padding,
+    and objdump's symbol annotations dropped."""
+    for address in sorted(code):
+        text = code[address]
+        mnemonic = text.split()[0] if text else ""
+        if counts.get(address, 0) < least or mnemonic.startswith(("j", "call", "nop", "ret")):
+            continue
+        print(re.sub(r"\s*(<[^>]*>|#.*)$", "", text))
+
+
 def main():
-    if "--" not in sys.argv or sys.argv.index("--") != 2:
+    args = sys.argv[1:]
+    body = None
+    if args[:1] == ["--body"] and len(args) > 1:
+        body, args = int(args[1]), args[2:]
+    if "--" not in args or args.index("--") != 1:
         sys.exit(__doc__)
-    suffix, command = sys.argv[1], sys.argv[3:]
+    suffix, command = args[0], args[2:]
     binary = command[0]
     start, end = function_range(binary, suffix)
     with tempfile.TemporaryDirectory() as tmp:
@@ -78,6 +101,9 @@ def main():
                        + command, check=True, capture_output=True)
         counts = executed(profile, start, end)
     code = disassembly(binary, start, end)
+    if body is not None:
+        print_body(code, counts, body)
+        return
     classes = collections.Counter()
     stack = 0
     for address, n in counts.items():

@@ -267,10 +267,11 @@ pub type OrientationTerms<const L: usize> = fn(&[Q<L>], &[Q<L>], F<L>, &mut [M3<
 #[inline(always)]
 pub fn orientation_terms<const L: usize>(qp: &[Q<L>], qbar_inv: &[Q<L>], weight: F<L>, terms: &mut [M3<L>]) {
     for ((term, &qp), &qbar_inv) in terms.iter_mut().zip(qp).zip(qbar_inv) {
-        *term = M3::from_quat(qp.mul(qbar_inv)).scale(weight);
+        *term = rotation_term(qp, qbar_inv, weight);
         // An empty barrier: it keeps the compiler from vectorising this loop across the joints (8 joints' terms
-        // at once, every value gathered and scattered: 208 instructions per term against 83 with it, callgrind
-        // on `scene_cost 20 1000x16 lanes`); each joint's term is then computed across the lanes.
+        // at once, every value gathered and scattered); each joint's term is then computed across the lanes.
+        // Callgrind on `scene_cost 20 1000x16 lanes`: 83 instructions per term (`terms8_avx2_version`, 23.3M for
+        // 280 000 terms), 208 in a build without the barrier (not in the repository).
         std::hint::black_box(());
     }
 }
@@ -278,7 +279,13 @@ pub fn orientation_terms<const L: usize>(qp: &[Q<L>], qbar_inv: &[Q<L>], weight:
 /// A member's orientation term of the group matrix.
 #[inline(always)]
 fn orientation_term<const L: usize>(qp: &[Q<L>], qbar_inv: &[Q<L>], j: usize, weight: F<L>) -> M3<L> {
-    M3::from_quat(qp[j].mul(qbar_inv[j])).scale(weight)
+    rotation_term(qp[j], qbar_inv[j], weight)
+}
+
+/// The orientation term of a member whose predicted rotation is `qp`: its turn from rest as a matrix, weighted.
+#[inline(always)]
+fn rotation_term<const L: usize>(qp: Q<L>, qbar_inv: Q<L>, weight: F<L>) -> M3<L> {
+    M3::from_quat(qp.mul(qbar_inv)).scale(weight)
 }
 
 #[inline(always)]

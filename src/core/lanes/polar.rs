@@ -12,9 +12,9 @@
 
 use glam::{Quat, Vec3};
 
-use super::scalar::{Quaternion, Vec, exp_series, length_squared, mul};
-use super::simd::{F, M3, Mask, Q, V3};
-use crate::core::polar::{CONVERGED_ANGLE, LANDING_ANGLE, MAX_NEWTON_ANGLE, MIN_PIVOT};
+use super::scalar::{Quaternion, Vec, length_squared, mul};
+use super::simd::{M3, Mask, Q, V3};
+use crate::core::polar::{CONVERGED_ANGLE, LANDING_ANGLE, LONG_TURN, MAX_NEWTON_ANGLE, MIN_PIVOT};
 use crate::core::rod::POLAR_ITERATIONS;
 
 /// Columns.
@@ -50,16 +50,16 @@ pub fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>) -> M3<L> {
             let (step, lands) = newton_step(&s, g, trace, muller);
             active[lane] = still & !lands;
             any_active |= active[lane];
-            let (turn, far) = exp_series(step);
-            any_far |= still & far;
+            // `polar::turn`: the Cayley map, and the exponential for long steps (after the loop: rare).
+            let turn = [step[0] * 0.5, step[1] * 0.5, step[2] * 0.5, 1.0];
+            any_far |= still & (length_squared(step) > LONG_TURN * LONG_TURN);
             steps.set(lane, step);
             next.set(lane, mul(quat, turn));
         }
         if any_far {
             exact_turns(q, &steps, &turning, &mut next);
         }
-        let renormalized = next.scale(F::splat(1.5) - next.dot(next) * 0.5);
-        *q = Q::select(Mask(turning), renormalized, *q);
+        *q = Q::select(Mask(turning), next.normalize(), *q);
         if !any_active {
             break;
         }
@@ -67,14 +67,14 @@ pub fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>) -> M3<L> {
     M3::from_quat(*q)
 }
 
-/// The turned rotation of the active lanes whose step is too long for the series (more than a radian), with
-/// the exact exponential (rare).
+/// The turned rotation of the active lanes whose step is longer than `polar::LONG_TURN`, with the exponential
+/// (rare).
 #[cold]
 #[inline(never)]
 fn exact_turns<const L: usize>(q: &Q<L>, steps: &V3<L>, active: &[bool; L], next: &mut Q<L>) {
     for lane in 0..L {
         let step = steps.get(lane);
-        if active[lane] && exp_series(step).1 {
+        if active[lane] && length_squared(step) > LONG_TURN * LONG_TURN {
             let turn = Quat::from_scaled_axis(Vec3::from_array(step)).to_array();
             next.set(lane, mul(q.get(lane), turn));
         }

@@ -9,6 +9,7 @@ use super::buffers::reserve_total;
 use super::error::{Error, Result};
 use super::math::{Transform, direction, nlerp_shorter, swing_to};
 use super::params::{ChainParams, EngineSettings, SLEEP_DELAY};
+use super::prefetch;
 use super::rod::{CONTACT_SETTLED, ChainConstants, RestGroups, RodState};
 use super::shape::{EncodedShape, Shape, ShapeFrame};
 use super::weights::{ViewWeighting, blend_weights};
@@ -237,6 +238,13 @@ impl Chain {
     /// Asleep under the anchor it fell asleep under: its world pose is the stored one.
     fn shows_stored_pose(&self) -> bool {
         self.asleep && same_bits(&self.anchor, &self.asleep_anchor)
+    }
+
+    /// Asks for the cache lines of the pose the read-backs show ([`prefetch`]): a read-back reads every chain's
+    /// pose long after the step wrote it.
+    pub(crate) fn prefetch_shown_pose(&self) {
+        let pose = if self.shows_stored_pose() { &self.asleep_world } else { &self.output };
+        prefetch::lines(&[prefetch::region(pose)]);
     }
 
     /// [`for_each_world_transform`](Self::for_each_world_transform) into `out` (the chain's joint count): a

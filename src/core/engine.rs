@@ -22,6 +22,10 @@ use super::weights::{ViewWeighting, view_direction};
 
 pub type ChainId = Id<Chain>;
 
+/// How many chains ahead the read-backs ask for a chain's pose: enough for a memory access (a few hundred
+/// cycles) to finish while the chains in between are read, a few cache lines each.
+const READ_AHEAD: usize = 4;
+
 /// Counters a host can show in a profiler overlay.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Stats {
@@ -870,6 +874,19 @@ impl Engine {
         self.order.iter().map(|&slot| self.chains.at(slot as usize).expect("live"))
     }
 
+    /// [`chains_in_order`](Self::chains_in_order) for the read-backs: each chain's shown pose is asked for
+    /// `READ_AHEAD` chains before it is read ([`Chain::prefetch_shown_pose`]).
+    fn chains_to_read(&self) -> impl Iterator<Item = &Chain> {
+        let chain = |slot: &u32| self.chains.at(*slot as usize).expect("live");
+        let ahead = self.order.iter().skip(READ_AHEAD).map(Some).chain(std::iter::repeat(None));
+        self.order.iter().zip(ahead).map(move |(slot, ahead)| {
+            if let Some(ahead) = ahead {
+                chain(ahead).prefetch_shown_pose();
+            }
+            chain(slot)
+        })
+    }
+
     /// Chain ids in creation order (the order of batched reads and writes).
     pub fn chain_ids(&self) -> impl Iterator<Item = ChainId> + '_ {
         self.order.iter().map(|&slot| self.chains.id_at(slot as usize).expect("live"))
@@ -879,7 +896,7 @@ impl Engine {
     /// without calling it when `capacity` is below the joint count.
     pub fn for_each_world_transform(&self, capacity: usize, mut f: impl FnMut(Transform)) -> Result<()> {
         self.check_capacity(capacity)?;
-        for chain in self.chains_in_order() {
+        for chain in self.chains_to_read() {
             chain.for_each_world_transform(&mut f);
         }
         Ok(())
@@ -889,7 +906,7 @@ impl Engine {
     /// the order of [`for_each_world_transform`](Self::for_each_world_transform).
     pub fn for_each_local_rotation(&self, capacity: usize, mut f: impl FnMut(Quat)) -> Result<()> {
         self.check_capacity(capacity)?;
-        for chain in self.chains_in_order() {
+        for chain in self.chains_to_read() {
             chain.local_rotations().for_each(&mut f);
         }
         Ok(())
@@ -927,7 +944,7 @@ impl Engine {
     fn fill_by_chain<T>(&self, out: &mut [T], mut fill: impl FnMut(&Chain, &mut [T])) -> Result<usize> {
         self.check_capacity(out.len())?;
         let mut written = 0;
-        for chain in self.chains_in_order() {
+        for chain in self.chains_to_read() {
             let joints = chain.joint_count();
             fill(chain, &mut out[written..written + joints]);
             written += joints;

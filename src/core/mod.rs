@@ -11,6 +11,7 @@
 //! - [`batch`]: many engines in one call (optionally on a thread pool)
 //! - [`params`]: settings, parameters, units
 //! - [`buffers`]: reusable buffers sized before the steps that fill them
+//! - [`prefetch`]: cache lines asked for ahead of the loops that read them
 //! - [`arena`], [`chain`], [`engine`]: objects, ids and the stepping loop (3.5, 3.6, 3.9)
 
 pub(crate) mod arcs;
@@ -29,6 +30,7 @@ pub mod lanes;
 pub mod math;
 pub mod params;
 pub mod polar;
+pub(crate) mod prefetch;
 pub(crate) mod reach;
 pub mod rod;
 pub mod shape;

@@ -1,0 +1,40 @@
+//! Software prefetch: asking for the cache lines of data a loop will read a little later, so that it arrives
+//! while the loop works on what came before. Chains live in separate allocations (a dozen per chain), too
+//! many streams for the hardware prefetchers to follow: the lane solver's loads ([`super::lanes`]) and the
+//! engine's read-backs, which read each chain's pose long after the step wrote it, ask for them ahead.
+//! Prefetching changes no result, only when data arrives.
+
+use multiversion::multiversion;
+use multiversion::target::match_target;
+
+/// A byte range to prefetch: its start and length. The address is never dereferenced here (a prefetch
+/// cannot fault), so it is carried as a plain address.
+pub(crate) type Region = (*const i8, usize);
+
+/// The bytes of `v`.
+pub(crate) fn region<T>(v: &[T]) -> Region {
+    (v.as_ptr().cast(), std::mem::size_of_val(v))
+}
+
+/// One prefetch per 64-byte line of each non-empty region where the CPU has AVX2; nothing elsewhere. The
+/// intrinsic is safe to call only in a function compiled with a target feature that implies SSE (that SSE is
+/// enabled for the whole x86-64 build does not count), hence the `multiversion` copy rather than plain code.
+#[multiversion(targets("x86_64+avx2"))]
+pub(crate) fn lines(regions: &[Region]) {
+    match_target! {
+        "x86_64+avx2" => {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            for &(start, bytes) in regions.iter().filter(|region| region.1 > 0) {
+                // From the line that holds the first byte.
+                let skew = start as usize % 64;
+                let first_line = start.wrapping_sub(skew);
+                for offset in (0..bytes + skew).step_by(64) {
+                    _mm_prefetch::<_MM_HINT_T0>(first_line.wrapping_add(offset));
+                }
+            }
+        }
+        _ => {
+            let _ = regions;
+        }
+    }
+}

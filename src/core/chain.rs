@@ -9,7 +9,6 @@ use super::buffers::reserve_total;
 use super::error::{Error, Result};
 use super::math::{Transform, direction, nlerp_shorter, swing_to};
 use super::params::{ChainParams, EngineSettings, SLEEP_DELAY};
-use super::prefetch;
 use super::rod::{CONTACT_SETTLED, ChainConstants, RestGroups, RodState};
 use super::shape::{EncodedShape, Shape, ShapeFrame};
 use super::weights::{ViewWeighting, blend_weights};
@@ -240,11 +239,15 @@ impl Chain {
         self.asleep && same_bits(&self.anchor, &self.asleep_anchor)
     }
 
-    /// Asks for the cache lines of the pose the read-backs show ([`prefetch`]): a read-back reads every chain's
-    /// pose long after the step wrote it.
-    pub(crate) fn prefetch_shown_pose(&self) {
-        let pose = if self.shows_stored_pose() { &self.asleep_world } else { &self.output };
-        prefetch::lines(&[prefetch::region(pose)]);
+    /// The pose the world read-backs show: the stored one for a sleeping chain that has not moved, the output
+    /// pose (relative to the anchor) otherwise.
+    pub(crate) fn shown_pose(&self) -> &[Transform] {
+        if self.shows_stored_pose() { &self.asleep_world } else { &self.output }
+    }
+
+    /// The output pose, relative to the anchor, whose rotations the local-rotation read-backs give.
+    pub(crate) fn output_pose(&self) -> &[Transform] {
+        &self.output
     }
 
     /// [`for_each_world_transform`](Self::for_each_world_transform) into `out` (the chain's joint count): a

@@ -16,6 +16,7 @@ use super::error::{Error, Result};
 use super::lanes::{Clock, FEWEST_IN_A_GROUP, LaneJob, LaneSolver, Solver};
 use super::math::{Transform, normalized_direction, normalized_rotation, rotation_angle};
 use super::params::{AnchorSource, ChainParams, EngineSettings, MAX_COORDINATE, MAX_RADIUS, TeleportMode};
+use super::prefetch;
 use super::reach::Reach;
 use super::rod::{ChainConstants, RodScratch, SubstepInput, carry_to_new_rest, substep};
 use super::weights::{ViewWeighting, view_direction};
@@ -874,14 +875,17 @@ impl Engine {
         self.order.iter().map(|&slot| self.chains.at(slot as usize).expect("live"))
     }
 
-    /// [`chains_in_order`](Self::chains_in_order) for the read-backs: each chain's shown pose is asked for
-    /// `READ_AHEAD` chains before it is read ([`Chain::prefetch_shown_pose`]).
-    fn chains_to_read(&self) -> impl Iterator<Item = &Chain> {
+    /// [`chains_in_order`](Self::chains_in_order) for the read-backs, which read each chain's `pose` long
+    /// after the step wrote it: the pose of a chain is asked for ([`prefetch`]) `READ_AHEAD` chains before it
+    /// is read.
+    fn chains_to_read(&self, pose: fn(&Chain) -> &[Transform]) -> impl Iterator<Item = &Chain> {
         let chain = |slot: &u32| self.chains.at(*slot as usize).expect("live");
+        let ask = move |chain: &Chain| prefetch::lines(&[prefetch::region(pose(chain))]);
+        self.order.iter().take(READ_AHEAD).for_each(|slot| ask(chain(slot)));
         let ahead = self.order.iter().skip(READ_AHEAD).map(Some).chain(std::iter::repeat(None));
         self.order.iter().zip(ahead).map(move |(slot, ahead)| {
             if let Some(ahead) = ahead {
-                chain(ahead).prefetch_shown_pose();
+                ask(chain(ahead));
             }
             chain(slot)
         })
@@ -896,7 +900,7 @@ impl Engine {
     /// without calling it when `capacity` is below the joint count.
     pub fn for_each_world_transform(&self, capacity: usize, mut f: impl FnMut(Transform)) -> Result<()> {
         self.check_capacity(capacity)?;
-        for chain in self.chains_to_read() {
+        for chain in self.chains_to_read(Chain::shown_pose) {
             chain.for_each_world_transform(&mut f);
         }
         Ok(())
@@ -906,7 +910,7 @@ impl Engine {
     /// the order of [`for_each_world_transform`](Self::for_each_world_transform).
     pub fn for_each_local_rotation(&self, capacity: usize, mut f: impl FnMut(Quat)) -> Result<()> {
         self.check_capacity(capacity)?;
-        for chain in self.chains_to_read() {
+        for chain in self.chains_to_read(Chain::output_pose) {
             chain.local_rotations().for_each(&mut f);
         }
         Ok(())
@@ -921,7 +925,7 @@ impl Engine {
     /// C ABI's `kdw_transform`): one pass over every chain's joints, with no call per joint to a callback that
     /// the compiler cannot inline.
     pub fn read_world_as<T>(&self, out: &mut [T], convert: impl Fn(Transform) -> T) -> Result<usize> {
-        self.fill_by_chain(out, |chain, slots| chain.write_world_as(slots, &convert))
+        self.fill_by_chain(out, Chain::shown_pose, |chain, slots| chain.write_world_as(slots, &convert))
     }
 
     /// Local rotations (see [`for_each_local_rotation`](Self::for_each_local_rotation)) into `out`.
@@ -932,19 +936,25 @@ impl Engine {
     /// [`read_local_rotations`](Self::read_local_rotations) into a host's own quaternion type, each converted by
     /// `convert` (see [`read_world_as`](Self::read_world_as)).
     pub fn read_local_rotations_as<T>(&self, out: &mut [T], convert: impl Fn(Quat) -> T) -> Result<usize> {
-        self.fill_by_chain(out, |chain, slots| {
+        self.fill_by_chain(out, Chain::output_pose, |chain, slots| {
             for (slot, rotation) in slots.iter_mut().zip(chain.local_rotations()) {
                 *slot = convert(rotation);
             }
         })
     }
 
-    /// Checks that `out` holds every joint, then hands `fill` each chain, in creation order, with its joints'
-    /// slots of `out`. Returns how many were written.
-    fn fill_by_chain<T>(&self, out: &mut [T], mut fill: impl FnMut(&Chain, &mut [T])) -> Result<usize> {
+    /// Checks that `out` holds every joint, then hands `fill` each chain, in creation order (its `pose` asked for
+    /// ahead: [`chains_to_read`](Self::chains_to_read)), with its joints' slots of `out`. Returns how many were
+    /// written.
+    fn fill_by_chain<T>(
+        &self,
+        out: &mut [T],
+        pose: fn(&Chain) -> &[Transform],
+        mut fill: impl FnMut(&Chain, &mut [T]),
+    ) -> Result<usize> {
         self.check_capacity(out.len())?;
         let mut written = 0;
-        for chain in self.chains_to_read() {
+        for chain in self.chains_to_read(pose) {
             let joints = chain.joint_count();
             fill(chain, &mut out[written..written + joints]);
             written += joints;

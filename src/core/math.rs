@@ -119,7 +119,7 @@ pub fn swing_to(q: Quat, axis: Vec3, direction: Vec3) -> Quat {
 }
 
 /// `exp` of a rotation vector: the quaternion turning by `|e|` about `e`, as `Quat::from_scaled_axis`. Short
-/// vectors (the usual case: a particle's turn in one substep, a solver correction) use Taylor series accurate
+/// vectors (the usual case: a particle's turn in one substep) use Taylor series accurate
 /// to float32 rounding up to 1 radian, with no square root and no call to `sincosf`.
 #[inline]
 pub fn exp_small(e: Vec3) -> Quat {

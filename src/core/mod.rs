@@ -11,7 +11,7 @@
 //! - [`batch`]: many engines in one call (optionally on a thread pool)
 //! - [`params`]: settings, parameters, units
 //! - [`buffers`]: reusable buffers sized before the steps that fill them
-//! - [`prefetch`]: cache lines asked for ahead of the loops that read them
+//! - `prefetch`: cache lines asked for ahead of the loops that read them
 //! - [`arena`], [`chain`], [`engine`]: objects, ids and the stepping loop (3.5, 3.6, 3.9)
 
 pub(crate) mod arcs;

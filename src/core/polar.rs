@@ -9,7 +9,7 @@
 //! reaches float precision in one or two steps; elsewhere (far from the answer, rank-deficient matrices) it
 //! is Müller's step unchanged. Everything is evaluated in the current rotation's frame, `S = R^T A`.
 //!
-//! A step `e` (a rotation vector) turns the quaternion by the Cayley map of `e` ([`turn`]) rather than by its
+//! A step `e` (a rotation vector) turns the quaternion by the Cayley map of `e` (`turn`) rather than by its
 //! exponential: the same rotation to second order, so the Newton step keeps its quadratic convergence, with no
 //! series in the iteration's chain of dependent operations, whose latency sets its time.
 
@@ -101,7 +101,7 @@ fn newton_step(s: &Mat3A, g: Vec3, trace: f32) -> Option<Vec3> {
 ///
 /// Normalised, the Cayley map turns about `e` by `2 atan(|e| / 2) = |e| - |e|^3 / 12 + ...`: at a landing step
 /// (`LANDING_ANGLE`) 2e-9 radians short of the exponential's turn, far below what the step itself leaves; a
-/// longer step falls short by more (4 % at `LONG_TURN`) and the next iteration takes the rest. Beyond
+/// longer step falls short by more (2 % at `LONG_TURN`) and the next iteration takes the rest. Beyond
 /// `LONG_TURN` the map saturates towards half a turn, and Müller's steps on a rank-1 matrix a quarter turn away
 /// can then alternate between two rotations for ever (`rank_deficient_matrix_stays_finite`); the exponential's
 /// turn by the step's whole length breaks that symmetry.

@@ -40,7 +40,7 @@ pub fn normalize(q: Quaternion) -> Quaternion {
     [q[0] * inv, q[1] * inv, q[2] * inv, q[3] * inv]
 }
 
-/// `kernel::exp_small`'s series (`math::exp_small`), and whether the turn is too long for it.
+/// `math::exp_small`'s series, and whether the turn is too long for it.
 #[inline(always)]
 pub fn exp_series(e: Vec) -> (Quaternion, bool) {
     let x2 = length_squared(e) * 0.25;
@@ -50,7 +50,7 @@ pub fn exp_series(e: Vec) -> (Quaternion, bool) {
     ([e[0] * half, e[1] * half, e[2] * half, cos], x2 > 0.25)
 }
 
-/// `kernel::log_small`'s series (`math::log_small`), zero where it does not apply, and whether the exact
+/// `math::log_small`'s series, zero where it does not apply, and whether the exact
 /// logarithm is needed (outside the series' range and not below glam's threshold, where it returns zero).
 #[inline(always)]
 pub fn log_series(q: Quaternion) -> (Vec, bool) {

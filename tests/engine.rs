@@ -316,3 +316,79 @@ fn blend_weights_are_readable() {
     assert!((w[1] - 0.5).abs() < 1e-6 && (w[2] - 0.25).abs() < 1e-6 && (w[0] - 0.25).abs() < 1e-6, "{w:?}");
     assert_eq!(engine.for_each_chain_weight(id, 2, |_| {}).unwrap_err().kind, ErrorKind::BufferTooSmall);
 }
+
+/// Particle positions are kept relative to the view reference's position, so a view reference that moves
+/// shifts every chain's state at every step, once, whichever way the chain goes that step: in a lane group, on
+/// the scalar solver after the lane groups (two chains of a joint count are too few for a group), disabled,
+/// asleep (and woken later), teleported, or carried to a new rest shape. The same world anchors and view directions under a view
+/// reference that stays at the origin give the same motion, up to the rounding of the different origins; a
+/// shift missed or taken twice would be off by the view reference's motion, 2 cm a frame.
+#[test]
+fn a_moving_view_reference_shifts_every_chain_once() {
+    let walk = |frame: usize| Vec3::new(0.02 * frame as f32, 0.0, 0.01 * frame as f32);
+    let run = |moving: bool| {
+        let mut engine = engine_with(EngineSettings::default());
+        let own = ChainParams { anchor: AnchorSource::Own, ..Default::default() };
+        let mut ids = Vec::new();
+        // Ten in lane groups, two on the scalar solver after them, one to sleep, one to disable for a while,
+        // one to teleport, one with a view shape (its rest shape changes with the view direction).
+        for (joints, count) in [(8, 10), (5, 2), (6, 4)] {
+            for _ in 0..count {
+                // The sleeper (the first of six joints) hangs straight down: at rest from the start.
+                let hanging = ids.len() == 12;
+                let direction = if hanging { Vec3::NEG_Y } else { Vec3::new(1.0, -1.0, 0.3) };
+                let base = straight_chain(joints, Vec3::ZERO, direction, 0.04);
+                ids.push(engine.create_chain(own, &base).unwrap());
+            }
+        }
+        let [sleeper, disabled, teleported, viewed] = [ids[12], ids[13], ids[14], ids[15]];
+        let bent = curled_chain(6, Vec3::ZERO, Vec3::new(1.0, -1.0, 0.3), Vec3::Z, 0.3, 0.04);
+        engine.add_view_shape(viewed, Vec3::Z, &bent, 1.0).unwrap();
+        let mut poses = Vec::new();
+        let mut slept = false;
+        for frame in 0..240 {
+            let head = HEAD + walk(frame);
+            let sway = Quat::from_rotation_y(0.5 * (0.1 * frame as f32).sin());
+            let anchors: Vec<Transform> = ids
+                .iter()
+                .enumerate()
+                .map(|(i, &id)| {
+                    let offset = Vec3::new(0.1 * (i % 4) as f32, 0.05 * (i / 4) as f32, 0.0);
+                    // The sleeper's anchor stays put until frame 200, which wakes it.
+                    match id == sleeper {
+                        true => at(offset + walk(frame.saturating_sub(200))),
+                        false => Transform::new(head + sway * offset, sway),
+                    }
+                })
+                .collect();
+            if frame == 20 {
+                engine.set_chain_enabled(disabled, false).unwrap();
+            }
+            if frame == 40 {
+                engine.set_chain_enabled(disabled, true).unwrap();
+            }
+            if frame == 30 {
+                engine.teleport_chain(teleported).unwrap();
+            }
+            let (camera, reference) = if moving {
+                (CAMERA + orbit_camera(Vec3::ZERO, 0.5, 0.05 * frame as f32) + walk(frame), at(walk(frame)))
+            } else {
+                (CAMERA + orbit_camera(Vec3::ZERO, 0.5, 0.05 * frame as f32), at(Vec3::ZERO))
+            };
+            engine.step_with_anchors(anchors.into_iter(), 1.0 / 60.0, camera, reference).unwrap();
+            slept |= frame < 200 && engine.is_chain_asleep(sleeper).unwrap();
+            poses.push(world(&engine));
+        }
+        assert!(slept, "the sleeper never slept");
+        assert!(!engine.is_chain_asleep(sleeper).unwrap(), "the sleeper woke");
+        poses
+    };
+    let (moving, still) = (run(true), run(false));
+    let largest = moving
+        .iter()
+        .zip(&still)
+        .flat_map(|(a, b)| a.iter().zip(b).map(|(a, b)| (a.position - b.position).length()))
+        .fold(0.0, f32::max);
+    println!("moving against still view reference: largest joint difference {largest:.2e} m over 240 frames");
+    assert!(largest < 1e-4, "{largest} m");
+}

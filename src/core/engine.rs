@@ -636,14 +636,12 @@ impl Engine {
 
     /// The step itself, on validated input (`dt > 0`, K normalised).
     fn advance(&mut self, dt: f32, camera: Vec3, k: Transform) {
-        // Rebase the particle state on the new origin.
+        // The particle state is rebased on the new origin once per chain: for a chain the lane solver steps, as
+        // its lane group loads it (a pass over every chain's positions fewer); for any other, below, before
+        // anything reads it.
         let origin = k.position;
         let shift = self.origin - origin;
-        if shift != Vec3::ZERO {
-            for &slot in &self.order {
-                self.chains.at_mut(slot as usize).expect("live").state.translate(shift.as_dvec3());
-            }
-        }
+        let rebase = (shift != Vec3::ZERO).then(|| shift.as_dvec3());
         self.origin = origin;
         if let Some(d) = view_direction(camera, &k) {
             self.view = Some(d);
@@ -690,6 +688,12 @@ impl Engine {
         let mut lane_chains = 0u32;
         for &slot in &self.order {
             let chain = self.chains.at_mut(slot as usize).expect("live");
+            let mut rebase = rebase;
+            let mut rebase_now = |chain: &mut Chain| {
+                if let Some(shift) = rebase.take() {
+                    chain.state.translate(shift);
+                }
+            };
             let anchor_world = match chain.params.anchor {
                 AnchorSource::ViewReference => k,
                 AnchorSource::Own => chain.anchor_pending,
@@ -698,6 +702,7 @@ impl Engine {
             let target = to_relative(&anchor_world);
             let mut start = to_relative(&chain.anchor);
             if !chain.enabled {
+                rebase_now(chain);
                 chain.anchor = anchor_world;
                 idle += 1;
                 continue;
@@ -711,10 +716,12 @@ impl Engine {
             let teleport = std::mem::take(&mut chain.teleport_requested)
                 || is_teleport(&start, &target, teleport_distance, settings.teleport_angle);
             if !chain.placed || (teleport && settings.teleport_mode == TeleportMode::Reset && resuming.is_none()) {
+                rebase_now(chain);
                 chain.place(&target);
                 start = target;
             } else if teleport || resuming.is_some() {
                 // Carry the chain rigidly: keeps its shape, adds no energy, no whip.
+                rebase_now(chain);
                 chain.state.carry(&target.mul(&start.inverse()));
                 start = target;
             }
@@ -732,6 +739,7 @@ impl Engine {
             let still = anchor_still && !teleport && !chain.rest_changed && !colliders_moving;
             if chain.asleep {
                 if still {
+                    rebase_now(chain);
                     idle += 1;
                     continue;
                 }
@@ -744,6 +752,7 @@ impl Engine {
                 if chain.rest_changed {
                     let share = params.momentum_suppression * params.alpha_per_substep(h as f32);
                     if share > 0.0 {
+                        rebase_now(chain);
                         let anchor = start.interpolate(&target, progress(0));
                         carry_to_new_rest(
                             &mut chain.state,
@@ -760,9 +769,11 @@ impl Engine {
                 chain.refresh_rest_groups();
             }
             if self.solver != Solver::Scalar && substeps > 0 {
-                self.lane_jobs.push(LaneJob { slot, joints: chain.joint_count(), start, target, constants, still });
+                let joints = chain.joint_count();
+                self.lane_jobs.push(LaneJob { slot, joints, start, target, constants, still, rebase });
                 continue;
             }
+            rebase_now(chain);
             let run = ScalarRun { start, target, constants, iterations, h, progress: &self.progress, reach: &reach };
             let (chain_fallbacks, pairs) = run.step(chain, Some(&mut self.contact_scratch), &mut self.scratch);
             fallbacks += chain_fallbacks;
@@ -787,6 +798,9 @@ impl Engine {
             // The last 1 or 2 chains of a joint count after its full lane groups are faster on the scalar solver.
             for job in &self.lane_leftovers {
                 let chain = self.chains.at_mut(job.slot as usize).expect("live");
+                if let Some(shift) = job.rebase {
+                    chain.state.translate(shift);
+                }
                 let run = ScalarRun {
                     start: job.start,
                     target: job.target,

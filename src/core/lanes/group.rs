@@ -23,6 +23,8 @@ pub(crate) struct LaneChain<'a> {
     pub lengths: &'a [f32],
     pub constants: &'a ChainConstants,
     pub half_kick: bool,
+    /// Added to the positions as they load ([`LaneJob::rebase`](super::LaneJob)).
+    pub rebase: Option<DVec3>,
     /// `Chain::local_current` (the previous pose of a step of one substep) and `Chain::bone_axes`.
     pub local_current: &'a [Transform],
     pub bone_axes: &'a [Vec3],
@@ -219,13 +221,19 @@ impl<const L: usize> LaneGroup<L> {
             (&st.x[..n], &st.v[..n], &st.q[..n], &st.w[..n], &st.group_rotation[..n])
         });
         let rests = chains.each_ref().map(|c| (&c.bone_axes[..n], &c.rest.orientations[..n], &c.offsets[..n]));
+        let rebases = chains.each_ref().map(|c| c.rebase);
         let (x, v, q, w, group_rotation) =
             (&mut self.x[..n], &mut self.v[..n], &mut self.q[..n], &mut self.w[..n], &mut self.group_rotation[..n]);
         let (bone_axes, qbars, qbar_invs, offsets) =
             (&mut self.bone_axes[..n], &mut self.qbar[..n], &mut self.qbar_inv[..n], &mut self.offsets[..n]);
         for j in 0..n {
             for (lane, st) in states.iter().enumerate() {
-                x[j].set(lane, st.0[j].to_array());
+                // `RodState::translate`'s addition, as the engine would have made it before the step.
+                let position = match rebases[lane] {
+                    Some(shift) => st.0[j] + shift,
+                    None => st.0[j],
+                };
+                x[j].set(lane, position.to_array());
                 v[j].set(lane, st.1[j].to_array());
                 q[j].set(lane, st.2[j].to_array());
                 w[j].set(lane, st.3[j].to_array());

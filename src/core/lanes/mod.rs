@@ -37,6 +37,7 @@ mod rotations;
 mod scalar;
 mod simd;
 
+use glam::DVec3;
 use multiversion::multiversion;
 
 use super::arena::Arena;
@@ -128,6 +129,8 @@ pub(crate) struct LaneJob {
     pub constants: ChainConstants,
     /// Nothing about the chain changed this step (towards sleeping).
     pub still: bool,
+    /// The shift of the engine origin its positions have yet to take this step (`Engine::advance`).
+    pub rebase: Option<DVec3>,
 }
 
 impl LaneJob {
@@ -439,6 +442,7 @@ fn run_group<const L: usize>(
             lengths: &chain.frame.lengths,
             constants: &job.constants,
             half_kick: chain.half_kick,
+            rebase: job.rebase,
             local_current: &chain.local_current,
             bone_axes: &chain.bone_axes,
         }

@@ -30,16 +30,31 @@ pub(crate) const MAX_NEWTON_ANGLE: f32 = 0.5;
 /// rounding difference between the lane and scalar solvers switches on and off (at 1e-2, `tests/lanes.rs`
 /// then counts more contact pairs on one solver than its bound allows).
 pub(crate) const LANDING_ANGLE: f32 = 3e-3;
+/// [`LANDING_ANGLE`] of a shape-matching pass that another pass of the same substep follows. Its last Newton
+/// step leaves an error that shrinks with the step's square (`a_rough_pass_leaves_what_the_polishing_pass_removes`:
+/// up to a quarter of it), and the next pass, warm-started from this pass's rotations, takes that out with its
+/// own steps: only the substep's last pass must end at float rounding. With two passes per substep, the first
+/// starts a substep's motion away from the last substep's answer, and its groups took a second Newton step
+/// about as often as not (the lane solver takes one for all its lanes while any one needs it); landing them
+/// after the first cut the polar decomposition's instructions by a quarter (README, "Speed", stop 31).
+pub(crate) const ROUGH_LANDING_ANGLE: f32 = 1e-1;
 /// Relative size of the Hessian's smallest pivot below which it counts as singular.
 pub(crate) const MIN_PIVOT: f32 = 1e-4;
 /// Steps longer than this (radians) turn by the exact exponential instead of the Cayley map ([`turn`]): the
 /// longest Newton step, so only Müller's steps far from the answer do.
 pub(crate) const LONG_TURN: f32 = MAX_NEWTON_ANGLE;
 
-/// Improves `q` in place towards the rotation part of `a`, for at most `max_iterations` iterations. Returns
+/// The landing angle of shape-matching pass `pass` of `passes` in a substep: only the last one polishes.
+#[inline]
+pub(crate) fn landing_angle(pass: u32, passes: u32) -> f32 {
+    if pass + 1 < passes { ROUGH_LANDING_ANGLE } else { LANDING_ANGLE }
+}
+
+/// Improves `q` in place towards the rotation part of `a`, for at most `max_iterations` iterations or until a
+/// Newton step shorter than `landing` (radians: [`landing_angle`]). Returns
 /// the rotation matrix of the final `q` (the convergence test has usually just computed it).
 #[inline]
-pub fn extract_rotation(a: &Mat3A, q: &mut Quat, max_iterations: u32) -> Mat3A {
+pub fn extract_rotation(a: &Mat3A, q: &mut Quat, max_iterations: u32, landing: f32) -> Mat3A {
     // The guard against a vanishing denominator scales with the matrix, so a millimetre-sized chain (entries
     // ~1e-7) is treated exactly like a metre-sized one.
     let guard = 1e-9 * (a.x_axis.length_squared() + a.y_axis.length_squared() + a.z_axis.length_squared()).sqrt()
@@ -58,7 +73,7 @@ pub fn extract_rotation(a: &Mat3A, q: &mut Quat, max_iterations: u32) -> Mat3A {
         }
         let newton = newton_step(&s, g, trace);
         *q = (*q * turn(newton.unwrap_or(muller))).normalize();
-        if newton.is_some_and(|step| step.length_squared() < LANDING_ANGLE * LANDING_ANGLE) {
+        if newton.is_some_and(|step| step.length_squared() < landing * landing) {
             break;
         }
     }
@@ -121,6 +136,7 @@ fn turn(e: Vec3) -> Quat {
 mod tests {
     use super::*;
     use crate::core::math::rotation_angle;
+    use crate::core::rod::POLAR_ITERATIONS;
     use glam::{Vec3, Vec3A};
 
     #[test]
@@ -129,7 +145,7 @@ mod tests {
         let stretch = Mat3A::from_diagonal(Vec3::new(2.0, 0.5, 1.3));
         let a = Mat3A::from_quat(truth) * stretch;
         let mut q = Quat::IDENTITY;
-        let frame = extract_rotation(&a, &mut q, 100);
+        let frame = extract_rotation(&a, &mut q, 100, LANDING_ANGLE);
         assert!(rotation_angle(q.inverse() * truth) < 1e-4);
         assert_eq!(frame, Mat3A::from_quat(q));
     }
@@ -142,13 +158,13 @@ mod tests {
         for a in [Mat3A::from_quat(truth), Mat3A::from_quat(truth) * stretch] {
             let mut q = Quat::from_euler(glam::EulerRot::XYZ, 0.45, 0.22, -0.12);
             let start = rotation_angle(q.inverse() * truth);
-            let frame = extract_rotation(&a, &mut q, 1);
+            let frame = extract_rotation(&a, &mut q, 1, LANDING_ANGLE);
             assert_eq!(frame, Mat3A::from_quat(q));
             let first = rotation_angle(q.inverse() * truth);
             assert!(first < 0.05 * start, "{first} vs {start}");
-            extract_rotation(&a, &mut q, 1);
+            extract_rotation(&a, &mut q, 1, LANDING_ANGLE);
             assert!(rotation_angle(q.inverse() * truth) < 1e-6);
-            extract_rotation(&a, &mut q, 12);
+            extract_rotation(&a, &mut q, 12, LANDING_ANGLE);
             assert!(rotation_angle(q.inverse() * truth) < 1e-6);
         }
     }
@@ -174,9 +190,17 @@ mod tests {
 
     /// The largest error left by `extract_rotation` with at most `iterations` from every start `offset` away.
     fn worst_error(offset: f32, iterations: u32) -> f32 {
+        worst_error_of_passes(offset, &[(iterations, LANDING_ANGLE)])
+    }
+
+    /// The largest error left by `extract_rotation` called once per `(iterations, landing)` of `passes`, each
+    /// from where the one before ended, from every start `offset` away.
+    fn worst_error_of_passes(offset: f32, passes: &[(u32, f32)]) -> f32 {
         starts_at(offset)
             .map(|(a, truth, mut q)| {
-                extract_rotation(&a, &mut q, iterations);
+                for &(iterations, landing) in passes {
+                    extract_rotation(&a, &mut q, iterations, landing);
+                }
                 rotation_angle(q.inverse() * truth)
             })
             .fold(0.0, f32::max)
@@ -204,12 +228,33 @@ mod tests {
     }
 
     #[test]
+    fn a_rough_pass_leaves_what_the_polishing_pass_removes() {
+        // Only the last shape-matching pass of a substep polishes (`landing_angle`).
+        assert_eq!(landing_angle(0, 2), ROUGH_LANDING_ANGLE);
+        assert_eq!(landing_angle(1, 2), LANDING_ANGLE);
+        assert_eq!(landing_angle(0, 1), LANDING_ANGLE);
+        let rough = [(POLAR_ITERATIONS, ROUGH_LANDING_ANGLE)];
+        let polished = [(POLAR_ITERATIONS, ROUGH_LANDING_ANGLE), (POLAR_ITERATIONS, LANDING_ANGLE)];
+        for offset in [1e-3, 1e-2, 5e-2, ROUGH_LANDING_ANGLE, 0.2] {
+            // What a rough landing leaves shrinks with the square of the start's distance (quadratic
+            // convergence: 0.24 of it from 5e-2, the most here), down to float rounding.
+            let left = worst_error_of_passes(offset, &rough);
+            assert!(left <= (0.5 * offset * offset).max(1e-6), "rough pass from {offset}: {left}");
+            // The polishing pass that follows ends at float rounding, as a polishing pass alone does.
+            let both = worst_error_of_passes(offset, &polished);
+            assert!(both < 1e-6, "rough then polishing pass from {offset}: {both}");
+        }
+        // A rough landing does land: from 5e-2 a polishing pass takes a second step, a rough one does not.
+        assert!(worst_error_of_passes(5e-2, &rough) > worst_error(5e-2, POLAR_ITERATIONS));
+    }
+
+    #[test]
     fn thin_matrix_twist_converges() {
         // A rod-like group: one large singular value. Müller's plain step would crawl on the twist.
         let truth = Quat::from_rotation_y(0.3) * Quat::from_rotation_x(0.2);
         let a = Mat3A::from_quat(truth) * Mat3A::from_diagonal(Vec3::new(1e-2, 1.0, 1e-2));
         let mut q = Quat::from_rotation_x(0.2);
-        extract_rotation(&a, &mut q, 8);
+        extract_rotation(&a, &mut q, 8, LANDING_ANGLE);
         assert!(rotation_angle(q.inverse() * truth) < 1e-5, "{}", rotation_angle(q.inverse() * truth));
     }
 
@@ -218,7 +263,7 @@ mod tests {
         // A two-point group without orientation terms: rank 1.
         let a = Mat3A::from_cols(Vec3A::new(0.0, 1.0, 0.0), Vec3A::ZERO, Vec3A::ZERO);
         let mut q = Quat::IDENTITY;
-        extract_rotation(&a, &mut q, 20);
+        extract_rotation(&a, &mut q, 20, LANDING_ANGLE);
         assert!(q.is_finite() && (q.length() - 1.0).abs() < 1e-5);
         // The one constrained column is aligned: x maps to y.
         assert!((q * Vec3::X - Vec3::Y).length() < 1e-3);
@@ -227,7 +272,7 @@ mod tests {
     #[test]
     fn zero_matrix_leaves_guess() {
         let mut q = Quat::from_rotation_x(0.3);
-        extract_rotation(&Mat3A::ZERO, &mut q, 10);
+        extract_rotation(&Mat3A::ZERO, &mut q, 10, LANDING_ANGLE);
         assert_eq!(q, Quat::from_rotation_x(0.3));
     }
 }

@@ -9,7 +9,7 @@ use super::collision::{ContactInput, SegmentBounds, collide, pre_stabilise};
 use super::inextensible::{self, ConstraintScratch, SolveMemory};
 use super::math::{Transform, align_hemisphere, exp_small, log_small, nlerp_shorter};
 use super::params::{ChainParams, EngineSettings};
-use super::polar::extract_rotation;
+use super::polar::{extract_rotation, landing_angle};
 use super::shape::Shape;
 
 /// Warm-started rotation extraction (Newton steps where the problem is well conditioned) reaches float
@@ -238,8 +238,8 @@ pub fn substep(
                 qp,
                 input.rest,
                 input.rest_groups,
-                input.constants.orientation_weight,
-                alpha,
+                &input.constants,
+                landing_angle(iteration, iterations),
             );
         }
         let solved = if iteration == 0 {
@@ -387,9 +387,10 @@ fn match_shape(
     qp: &mut [Quat],
     rest: &Shape,
     groups: &RestGroups,
-    orientation_weight: f32,
-    alpha: f32,
+    constants: &ChainConstants,
+    landing: f32,
 ) {
+    let (orientation_weight, alpha) = (constants.orientation_weight, constants.alpha_per_iteration);
     let n = p.len();
     if n < 2 {
         return;
@@ -436,7 +437,7 @@ fn match_shape(
             (c, a)
         };
         let mut rotation = group_rotation[i];
-        let frame = extract_rotation(&a, &mut rotation, POLAR_ITERATIONS);
+        let frame = extract_rotation(&a, &mut rotation, POLAR_ITERATIONS, landing);
         group_rotation[i] = rotation;
         pull_to_goal(&mut p[lo], c, frame * r_lo, alpha_f64);
         pull_to_goal(&mut p[i], c, frame * r_mid, alpha_f64);

@@ -11,6 +11,7 @@ use super::output;
 use super::rotations::{Predict, Spin, angular_velocities, predict_orientations};
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
 use crate::core::inextensible::{self, SolveMemory, Solved};
+use crate::core::polar::landing_angle;
 use crate::core::rod::FINAL_CONTACT_ROUNDS;
 use crate::core::warm_start::WARM_SLOTS;
 
@@ -142,6 +143,7 @@ pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, predict: Pr
 /// solves have been taking the exact projection start with it, from their remembered tensions.
 fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>, iteration: usize) -> Mask<L> {
     let first = iteration == 0;
+    g.landing_angle = landing_angle(iteration as u32, iterations(g));
     if g.shape_matching {
         (phases.match_shape)(g);
     }
@@ -200,7 +202,7 @@ pub fn finish_substep<const L: usize>(g: &mut LaneGroup<L>, spin: Spin<L>) {
 #[inline(always)]
 pub fn match_shape<const L: usize>(
     g: &mut LaneGroup<L>,
-    polar: fn(&M3<L>, &mut Q<L>) -> M3<L>,
+    polar: fn(&M3<L>, &mut Q<L>, f32) -> M3<L>,
     orientation_terms: OrientationTerms<L>,
 ) {
     let n = g.n;
@@ -249,7 +251,7 @@ pub fn match_shape<const L: usize>(
             (c, a)
         };
         let mut rotation = group_rotation[i];
-        let frame = polar(&a, &mut rotation);
+        let frame = polar(&a, &mut rotation, g.landing_angle);
         group_rotation[i] = rotation;
         p[lo] = pull_to_goal(p[lo], c, frame.mul_vec3(r_lo), alpha64);
         p[i] = pull_to_goal(p[i], c, frame.mul_vec3(r_mid), alpha64);

@@ -288,8 +288,8 @@ macro_rules! wide_phases {
         }
 
         #[multiversion(targets($target))]
-        fn $polar(a: &M3<$lanes>, q: &mut Q<$lanes>) -> M3<$lanes> {
-            polar::extract_rotation(a, q)
+        fn $polar(a: &M3<$lanes>, q: &mut Q<$lanes>, landing: f32) -> M3<$lanes> {
+            polar::extract_rotation(a, q, landing)
         }
 
         #[multiversion(targets($target))]

@@ -14,16 +14,17 @@ use glam::{Quat, Vec3};
 
 use super::scalar::{Quaternion, Vec, length_squared, mul};
 use super::simd::{M3, Mask, Q, V3};
-use crate::core::polar::{CONVERGED_ANGLE, LANDING_ANGLE, LONG_TURN, MAX_NEWTON_ANGLE, MIN_PIVOT};
+use crate::core::polar::{CONVERGED_ANGLE, LONG_TURN, MAX_NEWTON_ANGLE, MIN_PIVOT};
 use crate::core::rod::POLAR_ITERATIONS;
 
 /// Columns.
 type Mat = [Vec; 3];
 
 /// Improves every lane's `q` towards the rotation part of its `a`; a lane stops changing once it has
-/// converged or its Newton step has landed. Returns the rotation matrices of the final `q`.
+/// converged or its Newton step has landed (shorter than `landing`: `polar::landing_angle`). Returns the
+/// rotation matrices of the final `q`.
 #[inline(always)]
-pub fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>) -> M3<L> {
+pub fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>, landing: f32) -> M3<L> {
     let norm = (a.x_axis.length_squared() + a.y_axis.length_squared() + a.z_axis.length_squared()).sqrt();
     let guard = norm * 1e-9 + f32::MIN_POSITIVE;
     let mut active = [true; L];
@@ -47,7 +48,7 @@ pub fn extract_rotation<const L: usize>(a: &M3<L>, q: &mut Q<L>) -> M3<L> {
             // `&` rather than `&&`: no branch in the loop body.
             let still = active[lane] & !converged;
             turning[lane] = still;
-            let (step, lands) = newton_step(&s, g, trace, muller);
+            let (step, lands) = newton_step(&s, g, trace, muller, landing);
             active[lane] = still & !lands;
             any_active |= active[lane];
             // `polar::turn`: the Cayley map, and the exponential for long steps (after the loop: rare).
@@ -82,10 +83,10 @@ fn exact_turns<const L: usize>(q: &Q<L>, steps: &V3<L>, active: &[bool; L], next
 }
 
 /// `polar::newton_step`, or the Müller step `muller` where the Newton step is not trusted, and whether the step
-/// lands (`polar::LANDING_ANGLE`). A mirror rather than a call: that one takes glam's SIMD `Mat3A` and returns an
+/// lands (a Newton step shorter than `landing`). A mirror rather than a call: that one takes glam's SIMD `Mat3A` and returns an
 /// `Option`, and either keeps the lane loop scalar.
 #[inline(always)]
-fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec) -> (Vec, bool) {
+fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec, landing: f32) -> (Vec, bool) {
     let (h00, h11, h22) = (trace - s[0][0], trace - s[1][1], trace - s[2][2]);
     let h01 = (s[1][0] + s[0][1]) * -0.5;
     let h02 = (s[2][0] + s[0][2]) * -0.5;
@@ -107,7 +108,7 @@ fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec) -> (Vec, bool) {
     ];
     let step_squared = length_squared(step);
     let newton = definite & (step_squared <= MAX_NEWTON_ANGLE * MAX_NEWTON_ANGLE);
-    let lands = newton & (step_squared < LANDING_ANGLE * LANDING_ANGLE);
+    let lands = newton & (step_squared < landing * landing);
     (if newton { step } else { muller }, lands)
 }
 

@@ -418,22 +418,21 @@ fn match_shape(
         let orientation_term = |j: usize| Mat3A::from_quat(qp[j] * qbar[j].inverse()) * orientation_weight;
         let m_lo = orientation_term(lo);
         let m_mid = carried.take().unwrap_or_else(|| orientation_term(i));
-        // Uniform masses cancel out of the group matrix.
+        // Uniform masses cancel out of the group matrix. Its position terms `sum (p_k - c) r_k^T` are taken
+        // relative to the middle particle instead of the centre `c`: the rest offsets `r_k` sum to zero, so
+        // that changes only rounding, the middle particle's term vanishes, and the matrix does not wait for the
+        // centre's division (README, "Speed", stop 31).
         let (c, a) = if full {
             let hi = i + 1;
             let m_hi = orientation_term(hi);
             carried = Some(m_hi);
             let c = (DVec3::ZERO + p[lo] + p[i] + p[hi]) / 3.0;
-            let a = m_lo
-                + outer((p[lo] - c).as_vec3a(), r_lo)
-                + m_mid
-                + outer((p[i] - c).as_vec3a(), r_mid)
-                + m_hi
-                + outer((p[hi] - c).as_vec3a(), r_hi);
+            let a =
+                m_lo + outer((p[lo] - p[i]).as_vec3a(), r_lo) + m_mid + m_hi + outer((p[hi] - p[i]).as_vec3a(), r_hi);
             (c, a)
         } else {
             let c = (DVec3::ZERO + p[lo] + p[i]) / 2.0;
-            let a = m_lo + outer((p[lo] - c).as_vec3a(), r_lo) + m_mid + outer((p[i] - c).as_vec3a(), r_mid);
+            let a = m_lo + outer((p[lo] - p[i]).as_vec3a(), r_lo) + m_mid;
             (c, a)
         };
         let mut rotation = group_rotation[i];

@@ -233,21 +233,20 @@ pub fn match_shape<const L: usize>(
         let [r_lo, r_mid, r_hi] = offsets[i];
         let m_lo = orientation_term(qp, qbar_inv, lo, ow);
         let m_mid = terms[i];
+        // The position terms relative to the middle particle (`rod::match_shape`).
         let (c, a) = if full {
             let hi = i + 1;
             let m_hi = terms[hi];
             let c = (DV3::ZERO + p[lo] + p[i] + p[hi]) / 3.0;
             let a = m_lo
-                .add(M3::outer((p[lo] - c).to_f32(), r_lo))
+                .add(M3::outer((p[lo] - p[i]).to_f32(), r_lo))
                 .add(m_mid)
-                .add(M3::outer((p[i] - c).to_f32(), r_mid))
                 .add(m_hi)
-                .add(M3::outer((p[hi] - c).to_f32(), r_hi));
+                .add(M3::outer((p[hi] - p[i]).to_f32(), r_hi));
             (c, a)
         } else {
             let c = (DV3::ZERO + p[lo] + p[i]) / 2.0;
-            let a =
-                m_lo.add(M3::outer((p[lo] - c).to_f32(), r_lo)).add(m_mid).add(M3::outer((p[i] - c).to_f32(), r_mid));
+            let a = m_lo.add(M3::outer((p[lo] - p[i]).to_f32(), r_lo)).add(m_mid);
             (c, a)
         };
         let mut rotation = group_rotation[i];

@@ -25,11 +25,13 @@ pub(crate) fn lines(regions: &[Region]) {
         "x86_64+avx2" => {
             use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
             for &(start, bytes) in regions.iter().filter(|region| region.1 > 0) {
-                // From the line that holds the first byte.
-                let skew = start as usize % 64;
-                let first_line = start.wrapping_sub(skew);
-                for offset in (0..bytes + skew).step_by(64) {
-                    _mm_prefetch::<_MM_HINT_T0>(first_line.wrapping_add(offset));
+                // From the line that holds the first byte to the one that holds the last, as a plain loop over
+                // addresses (`step_by` over offsets: a quarter more instructions in `lines`).
+                let end = start as usize + bytes;
+                let mut line = start.wrapping_sub(start as usize % 64);
+                while (line as usize) < end {
+                    _mm_prefetch::<_MM_HINT_T0>(line);
+                    line = line.wrapping_add(64);
                 }
             }
         }

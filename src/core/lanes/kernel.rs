@@ -249,9 +249,9 @@ pub fn match_shape<const L: usize>(
             let a = m_lo.add(M3::outer((p[lo] - p[i]).to_f32(), r_lo)).add(m_mid);
             (c, a)
         };
-        let mut rotation = group_rotation[i];
-        let frame = polar(&a, &mut rotation, g.landing_angle);
-        group_rotation[i] = rotation;
+        // In place: a copy of the rotation made for the call went through the stack both ways.
+        let frame = polar(&a, &mut group_rotation[i], g.landing_angle);
+        let rotation = group_rotation[i];
         p[lo] = pull_to_goal(p[lo], c, frame.mul_vec3(r_lo), alpha64);
         p[i] = pull_to_goal(p[i], c, frame.mul_vec3(r_mid), alpha64);
         if full {

@@ -23,8 +23,8 @@ use super::weights::{ViewWeighting, view_direction};
 
 pub type ChainId = Id<Chain>;
 
-/// How many chains ahead the read-backs ask for a chain's pose: enough for a memory access (a few hundred
-/// cycles) to finish while the chains in between are read, a few cache lines each.
+/// How many chains ahead the read-backs ask for a chain's pose, and the step for what its rest update reads:
+/// enough for a memory access (a few hundred cycles) to finish while the chains in between are handled.
 const READ_AHEAD: usize = 4;
 
 /// Counters a host can show in a profiler overlay.
@@ -686,7 +686,15 @@ impl Engine {
         let mut contact_pairs = 0u64;
         let mut idle = 0u32;
         let mut lane_chains = 0u32;
-        for &slot in &self.order {
+        let view = self.view;
+        let rest_update_ahead = |chains: &Arena<Chain>, slot: Option<&u32>| {
+            if let Some(chain) = slot.and_then(|&slot| chains.at(slot as usize)) {
+                chain.prefetch_rest_update(view);
+            }
+        };
+        self.order.iter().take(READ_AHEAD).for_each(|slot| rest_update_ahead(&self.chains, Some(slot)));
+        for (index, &slot) in self.order.iter().enumerate() {
+            rest_update_ahead(&self.chains, self.order.get(index + READ_AHEAD));
             let chain = self.chains.at_mut(slot as usize).expect("live");
             let mut rebase = rebase;
             let mut rebase_now = |chain: &mut Chain| {

@@ -36,7 +36,9 @@ pub(crate) const LANDING_ANGLE: f32 = 3e-3;
 /// own steps: only the substep's last pass must end at float rounding. With two passes per substep, the first
 /// starts a substep's motion away from the last substep's answer, and its groups took a second Newton step
 /// about as often as not (the lane solver takes one for all its lanes while any one needs it); landing them
-/// after the first cut the polar decomposition's instructions by a quarter (README, "Speed", stop 31).
+/// after the first cut the polar decomposition's instructions by a quarter (README, "Speed", stop 31). Unlike
+/// a later landing in every pass (above), the lane and scalar solvers' contact-pair counts stay within the bound
+/// of `tests/lanes.rs`: the last pass's rotations, which the substep's positions keep, are polished as before.
 pub(crate) const ROUGH_LANDING_ANGLE: f32 = 1e-1;
 /// Relative size of the Hessian's smallest pivot below which it counts as singular.
 pub(crate) const MIN_PIVOT: f32 = 1e-4;

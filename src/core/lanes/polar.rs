@@ -83,8 +83,8 @@ fn exact_turns<const L: usize>(q: &Q<L>, steps: &V3<L>, active: &[bool; L], next
 }
 
 /// `polar::newton_step`, or the Müller step `muller` where the Newton step is not trusted, and whether the step
-/// lands (a Newton step shorter than `landing`). A mirror rather than a call: that one takes glam's SIMD `Mat3A` and returns an
-/// `Option`, and either keeps the lane loop scalar.
+/// lands (a Newton step shorter than `landing`). A mirror rather than a call: that one takes glam's SIMD `Mat3A`
+/// and returns an `Option`, and either keeps the lane loop scalar.
 #[inline(always)]
 fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec, landing: f32) -> (Vec, bool) {
     let (h00, h11, h22) = (trace - s[0][0], trace - s[1][1], trace - s[2][2]);

@@ -411,11 +411,6 @@ impl<const L: usize> Q<L> {
 
     /// The inverse of a unit quaternion (glam's `inverse`).
     #[inline(always)]
-    pub fn conjugate(self) -> Self {
-        Self { x: -self.x, y: -self.y, z: -self.z, w: self.w }
-    }
-
-    #[inline(always)]
     pub fn normalize(self) -> Self {
         let inv = F::splat(1.0) / self.dot(self).sqrt();
         self.scale(inv)

@@ -72,42 +72,85 @@ pub fn write<const L: usize>(g: &mut LaneGroup<L>, t: f32) {
         let ((_, from), (_, to)) = (g.local_previous[j], g.local_current[j]);
         g.output[j].1 = from.nlerp_shorter(to, t);
     }
-    let lerp = |a: V3<L>, b: V3<L>| a.scale(F::splat(1.0) - t) + b.scale(t);
-    g.output[0].0 = lerp(g.local_previous[0].0, g.local_current[0].0);
-    for j in 0..n - 1 {
-        let before = g.local_previous[j + 1].0 - g.local_previous[j].0;
-        let after = g.local_current[j + 1].0 - g.local_current[j].0;
-        let (a, a_found) = direction(before);
-        let (b, b_found) = direction(after);
-        let (mixed, mixed_found) = direction(lerp(a, b));
-        let axis = g.bone_axes[j];
-        // `write_output`'s match: both directions, then whichever exists, then the bone axis.
-        let either = V3::select(b_found, b, V3::select(a_found, a, axis));
-        let blended = V3::select(a_found.and(b_found), V3::select(mixed_found, mixed, b), either);
-        g.output[j + 1].0 = g.output[j].0 + blended.scale(g.lengths[j]);
-        g.output[j].1 = swing(g.output[j].1, axis, blended);
+    g.output[0].0 = g.local_previous[0].0.scale(F::splat(1.0) - t) + g.local_current[0].0.scale(t);
+    bones(
+        &g.local_previous[..n],
+        &g.local_current[..n],
+        &g.bone_axes[..n],
+        &g.lengths[..n - 1],
+        t.0[0],
+        &mut g.output[..n],
+    );
+}
+
+/// The bones of [`write`] after the root's position: each segment's direction blended between the last two
+/// poses, the next joint's position along it, and the joint's rotation swung onto it. A loop over the lanes
+/// whose body is one lane's scalar code (`scalar`; the lane types' operations in their order), like
+/// [`capture`]: written with the lane types' operations, the per-lane conditions (`Mask`, an array of `bool`)
+/// kept half of the phase in 128-bit instructions and a fifth of it on the stack. The same bits.
+#[inline(always)]
+fn bones<const L: usize>(
+    previous: &[(V3<L>, Q<L>)],
+    current: &[(V3<L>, Q<L>)],
+    axes: &[V3<L>],
+    lengths: &[F<L>],
+    t: f32,
+    output: &mut [(V3<L>, Q<L>)],
+) {
+    let lerp = |a: Vec, b: Vec| [a[0] * (1.0 - t) + b[0] * t, a[1] * (1.0 - t) + b[1] * t, a[2] * (1.0 - t) + b[2] * t];
+    for j in 0..lengths.len() {
+        let (from, to) = ((&previous[j].0, &previous[j + 1].0), (&current[j].0, &current[j + 1].0));
+        let (axis, length, start, q) = (&axes[j], &lengths[j], output[j].0, output[j].1);
+        let (mut next, mut blended, mut turned, mut swung) = (V3::ZERO, V3::ZERO, V3::ZERO, q);
+        let mut folded = [false; L];
+        for lane in 0..L {
+            let (a, a_found) = direction_of(sub(from.1.get(lane), from.0.get(lane)));
+            let (b, b_found) = direction_of(sub(to.1.get(lane), to.0.get(lane)));
+            let (mixed, mixed_found) = direction_of(lerp(a, b));
+            let axis = axis.get(lane);
+            // `write_output`'s match: both directions, then whichever exists, then the bone axis.
+            let either = if b_found {
+                b
+            } else if a_found {
+                a
+            } else {
+                axis
+            };
+            let along = if a_found & b_found { if mixed_found { mixed } else { b } } else { either };
+            let (p, l) = (start.get(lane), length.0[lane]);
+            next.set(lane, [p[0] + along[0] * l, p[1] + along[1] * l, p[2] + along[2] * l]);
+            blended.set(lane, along);
+            // `math::swing_to`'s single-precision arc within a right angle; the lanes beyond it: `swing_folded`.
+            let q = q.get(lane);
+            let at = rotate(q, axis);
+            let cos = at[0] * along[0] + at[1] * along[1] + at[2] * along[2];
+            let turn = [
+                at[1] * along[2] - along[1] * at[2],
+                at[2] * along[0] - along[2] * at[0],
+                at[0] * along[1] - along[0] * at[1],
+            ];
+            swung.set(lane, normalize(mul([turn[0], turn[1], turn[2], 1.0 + cos], q)));
+            turned.set(lane, at);
+            // Not within a right angle, or NaN: `!(cos > 0.0)`.
+            folded[lane] = cos.is_nan() | (cos <= 0.0);
+        }
+        output[j + 1].0 = next;
+        let folded = Mask(folded);
+        output[j].1 = if folded.any() { swing_folded(q, *axis, turned, blended, folded, swung) } else { swung };
     }
 }
 
-/// `math::direction` on every lane: the unit vector and whether there is one.
+/// `math::direction` of one lane: the unit vector and whether there is one.
 #[inline(always)]
-fn direction<const L: usize>(v: V3<L>) -> (V3<L>, Mask<L>) {
-    let length = v.length_squared().sqrt();
-    let found = length.gt(F::splat(f32::MIN_POSITIVE.sqrt())).and(length.is_finite());
-    (V3 { x: v.x / length, y: v.y / length, z: v.z / length }, found)
+fn direction_of(v: Vec) -> (Vec, bool) {
+    let length = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let found = (length > f32::MIN_POSITIVE.sqrt()) & length.is_finite();
+    ([v[0] / length, v[1] / length, v[2] / length], found)
 }
 
-/// `math::swing_to` on every lane: its single-precision arc within a right angle, and beyond it
-/// [`swing_folded`].
 #[inline(always)]
-fn swing<const L: usize>(q: Q<L>, axis: V3<L>, direction: V3<L>) -> Q<L> {
-    let current = q.rotate(axis);
-    let cos = current.dot(direction);
-    let turn = current.cross(direction);
-    let arc = Q { x: turn.x, y: turn.y, z: turn.z, w: F::splat(1.0) + cos };
-    let swung = arc.mul(q).normalize();
-    let folded = cos.gt(F::splat(0.0)).not();
-    if folded.any() { swing_folded(q, axis, current, direction, folded, swung) } else { swung }
+fn sub(a: Vec, b: Vec) -> Vec {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// The lanes of `folded` (a bone more than a right angle from its segment: common on limp chains, whose

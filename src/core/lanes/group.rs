@@ -48,8 +48,6 @@ pub struct LaneGroup<const L: usize> {
     pub(super) iterations: u32,
     pub(super) shape_matching: bool,
     pub(super) substeps: usize,
-    /// The polar decomposition's landing angle for the current shape-matching pass (`polar::landing_angle`).
-    pub(super) landing_angle: f32,
     // Particle state.
     pub(super) x: Vec<DV3<L>>,
     pub(super) v: Vec<V3<L>>,

@@ -21,7 +21,8 @@ use crate::core::warm_start::WARM_SLOTS;
 /// operation count).
 pub struct Phases<const L: usize> {
     pub begin: fn(&mut LaneGroup<L>, usize),
-    pub match_shape: fn(&mut LaneGroup<L>),
+    /// One shape-matching pass; its polar decompositions land below the given angle (`polar::landing_angle`).
+    pub match_shape: fn(&mut LaneGroup<L>, f32),
     /// The direct solve on some lanes, from a multiplier history (a slot of `LaneGroup::warm`) or none.
     pub solve_lengths: fn(&mut LaneGroup<L>, Mask<L>, Option<usize>) -> Mask<L>,
     pub finish: fn(&mut LaneGroup<L>),
@@ -34,7 +35,7 @@ impl<const L: usize> Phases<L> {
     /// The phases compiled for the baseline instruction set.
     pub const PORTABLE: Self = Self {
         begin: |g, s| begin_substep(g, s, predict_orientations),
-        match_shape: |g| match_shape(g, super::polar::extract_rotation, orientation_terms),
+        match_shape: |g, landing| match_shape(g, landing, super::polar::extract_rotation, orientation_terms),
         solve_lengths: |g, lanes, warm| solve_lengths(g, lanes, warm, &Passes::PORTABLE),
         finish: |g| finish_substep(g, angular_velocities),
         capture: output::capture,
@@ -143,9 +144,8 @@ pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, predict: Pr
 /// solves have been taking the exact projection start with it, from their remembered tensions.
 fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>, iteration: usize) -> Mask<L> {
     let first = iteration == 0;
-    g.landing_angle = landing_angle(iteration as u32, iterations(g));
     if g.shape_matching {
-        (phases.match_shape)(g);
+        (phases.match_shape)(g, landing_angle(iteration as u32, iterations(g)));
     }
     // Most groups have no lane that remembers anything.
     let remembering = first && g.memories.iter().any(SolveMemory::in_streak);
@@ -202,6 +202,7 @@ pub fn finish_substep<const L: usize>(g: &mut LaneGroup<L>, spin: Spin<L>) {
 #[inline(always)]
 pub fn match_shape<const L: usize>(
     g: &mut LaneGroup<L>,
+    landing: f32,
     polar: fn(&M3<L>, &mut Q<L>, f32) -> M3<L>,
     orientation_terms: OrientationTerms<L>,
 ) {
@@ -250,7 +251,7 @@ pub fn match_shape<const L: usize>(
             (c, a)
         };
         // In place: a copy of the rotation made for the call went through the stack both ways.
-        let frame = polar(&a, &mut group_rotation[i], g.landing_angle);
+        let frame = polar(&a, &mut group_rotation[i], landing);
         let rotation = group_rotation[i];
         p[lo] = pull_to_goal(p[lo], c, frame.mul_vec3(r_lo), alpha64);
         p[i] = pull_to_goal(p[i], c, frame.mul_vec3(r_mid), alpha64);

@@ -278,8 +278,8 @@ macro_rules! wide_phases {
         }
 
         #[multiversion(targets($target))]
-        fn $match_shape(g: &mut LaneGroup<$lanes>) {
-            kernel::match_shape(g, $polar, $terms)
+        fn $match_shape(g: &mut LaneGroup<$lanes>, landing: f32) {
+            kernel::match_shape(g, landing, $polar, $terms)
         }
 
         #[multiversion(targets($target))]

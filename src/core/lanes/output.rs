@@ -10,8 +10,8 @@
 use glam::{DQuat, Quat, Vec3};
 
 use super::group::LaneGroup;
-use super::scalar::{Quaternion, Vec, mul, normalize};
-use super::simd::{DV3, F, Mask, Q, V3};
+use super::scalar::{Vec, cross, direction, dot, mul, normalize, rotate, sub};
+use super::simd::{F, Mask, Q, V3};
 use crate::core::math::swing_to;
 
 /// `Chain::capture_local` on every lane: the pose after substep `s` relative to that substep's anchor becomes
@@ -21,19 +21,13 @@ use crate::core::math::swing_to;
 /// operations in its order), like the polar decomposition: written with the lane types' operations, the
 /// compiler split the whole capture into 128-bit halves and kept them on the stack. `tools/instruction_mix.py
 /// capture8_avx2_version -- target/release/examples/scene_cost 20 1000x16 lanes`: 28.2M instructions, 74 %
-/// 128-bit and 45 % reading or writing the stack, before; 10.3M, 95 % 256-bit, now. The same bits.
+/// 128-bit and 45 % reading or writing the stack, before; 10.7M, 95 % 256-bit, now. The same bits.
 #[inline(always)]
 pub fn capture<const L: usize>(g: &mut LaneGroup<L>, s: usize) {
     std::mem::swap(&mut g.local_previous, &mut g.local_current);
+    let (anchor_position, anchor_rotation) = &g.anchors[s];
     let n = g.n;
-    to_local(&g.x[..n], &g.q[..n], &g.anchors[s], &mut g.local_current[..n]);
-}
-
-/// The particles `x`, `q` relative to `anchor`, into `local`. A function of its own, so that the compiler knows
-/// its slices apart (taken inside `capture`, they could overlap as far as it knew, and it left the loop scalar).
-#[inline(always)]
-fn to_local<const L: usize>(x: &[DV3<L>], q: &[Q<L>], anchor: &(V3<L>, Q<L>), local: &mut [(V3<L>, Q<L>)]) {
-    let (anchor_position, anchor_rotation) = anchor;
+    let (x, q, local) = (&g.x[..n], &g.q[..n], &mut g.local_current[..n]);
     for ((x, q), (position, rotation)) in x.iter().zip(q).zip(local.iter_mut()) {
         // The offsets from the anchor first, on their own: in one loop with the single-precision work, the
         // compiler ran all of it at the double-precision width (4 lanes a register).
@@ -47,20 +41,6 @@ fn to_local<const L: usize>(x: &[DV3<L>], q: &[Q<L>], anchor: &(V3<L>, Q<L>), lo
         }
         (*position, *rotation) = (to_position, to_rotation);
     }
-}
-
-/// `Q::rotate`: `q` rotating `v`, operation for operation.
-#[inline(always)]
-fn rotate([bx, by, bz, w]: Quaternion, v: Vec) -> Vec {
-    let b2 = bx * bx + by * by + bz * bz;
-    let along = (v[0] * bx + v[1] * by + v[2] * bz) * 2.0;
-    let (s1, s3) = (w * w - b2, w * 2.0);
-    let cross = [by * v[2] - v[1] * bz, bz * v[0] - v[2] * bx, bx * v[1] - v[0] * by];
-    [
-        v[0] * s1 + bx * along + cross[0] * s3,
-        v[1] * s1 + by * along + cross[1] * s3,
-        v[2] * s1 + bz * along + cross[2] * s3,
-    ]
 }
 
 /// `Chain::write_output` on every lane, at fraction `t` along the last two captured poses.
@@ -104,9 +84,9 @@ fn bones<const L: usize>(
         let (mut next, mut blended, mut turned, mut swung) = (V3::ZERO, V3::ZERO, V3::ZERO, q);
         let mut folded = [false; L];
         for lane in 0..L {
-            let (a, a_found) = direction_of(sub(from.1.get(lane), from.0.get(lane)));
-            let (b, b_found) = direction_of(sub(to.1.get(lane), to.0.get(lane)));
-            let (mixed, mixed_found) = direction_of(lerp(a, b));
+            let (a, a_found) = direction(sub(from.1.get(lane), from.0.get(lane)));
+            let (b, b_found) = direction(sub(to.1.get(lane), to.0.get(lane)));
+            let (mixed, mixed_found) = direction(lerp(a, b));
             let axis = axis.get(lane);
             // `write_output`'s match: both directions, then whichever exists, then the bone axis.
             let either = if b_found {
@@ -123,12 +103,7 @@ fn bones<const L: usize>(
             // `math::swing_to`'s single-precision arc within a right angle; the lanes beyond it: `swing_folded`.
             let q = q.get(lane);
             let at = rotate(q, axis);
-            let cos = at[0] * along[0] + at[1] * along[1] + at[2] * along[2];
-            let turn = [
-                at[1] * along[2] - along[1] * at[2],
-                at[2] * along[0] - along[2] * at[0],
-                at[0] * along[1] - along[0] * at[1],
-            ];
+            let (cos, turn) = (dot(at, along), cross(at, along));
             swung.set(lane, normalize(mul([turn[0], turn[1], turn[2], 1.0 + cos], q)));
             turned.set(lane, at);
             // Not within a right angle, or NaN: `!(cos > 0.0)`.
@@ -138,19 +113,6 @@ fn bones<const L: usize>(
         let folded = Mask(folded);
         output[j].1 = if folded.any() { swing_folded(q, *axis, turned, blended, folded, swung) } else { swung };
     }
-}
-
-/// `math::direction` of one lane: the unit vector and whether there is one.
-#[inline(always)]
-fn direction_of(v: Vec) -> (Vec, bool) {
-    let length = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let found = (length > f32::MIN_POSITIVE.sqrt()) & length.is_finite();
-    ([v[0] / length, v[1] / length, v[2] / length], found)
-}
-
-#[inline(always)]
-fn sub(a: Vec, b: Vec) -> Vec {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// The lanes of `folded` (a bone more than a right angle from its segment: common on limp chains, whose

@@ -1,5 +1,5 @@
 //! One lane's arithmetic, for the kernel parts written as loops over lanes ([`polar`](super::polar),
-//! [`rotations`](super::rotations)): the lane types' operations (`simd`) on plain arrays, operation for
+//! [`rotations`](super::rotations), [`output`](super::output)): the lane types' operations (`simd`) on plain arrays, operation for
 //! operation and in the same order, so a lane loop computes the bits the array operations would.
 
 /// A 3-vector.
@@ -10,6 +10,44 @@ pub type Quaternion = [f32; 4];
 #[inline(always)]
 pub fn length_squared(v: Vec) -> f32 {
     v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
+}
+
+/// `V3::dot`.
+#[inline(always)]
+pub fn dot(a: Vec, b: Vec) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// `V3::cross`: `a x b`.
+#[inline(always)]
+pub fn cross(a: Vec, b: Vec) -> Vec {
+    [a[1] * b[2] - b[1] * a[2], a[2] * b[0] - b[2] * a[0], a[0] * b[1] - b[0] * a[1]]
+}
+
+#[inline(always)]
+pub fn sub(a: Vec, b: Vec) -> Vec {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// `math::direction` (the lanes' `output` mirror of it): the unit vector and whether there is one.
+#[inline(always)]
+pub fn direction(v: Vec) -> (Vec, bool) {
+    let length = length_squared(v).sqrt();
+    let found = (length > f32::MIN_POSITIVE.sqrt()) & length.is_finite();
+    ([v[0] / length, v[1] / length, v[2] / length], found)
+}
+
+/// `Q::rotate`: `q` rotating `v`.
+#[inline(always)]
+pub fn rotate([bx, by, bz, w]: Quaternion, v: Vec) -> Vec {
+    let b = [bx, by, bz];
+    let (s1, along, s3) = (w * w - length_squared(b), dot(v, b) * 2.0, w * 2.0);
+    let cross = cross(b, v);
+    [
+        v[0] * s1 + bx * along + cross[0] * s3,
+        v[1] * s1 + by * along + cross[1] * s3,
+        v[2] * s1 + bz * along + cross[2] * s3,
+    ]
 }
 
 #[inline(always)]

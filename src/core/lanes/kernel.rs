@@ -7,6 +7,7 @@
 use super::contacts;
 use super::group::LaneGroup;
 use super::lengths::{Passes, solve_lengths};
+use super::matching::{self, GroupFn, Stiffness};
 use super::output;
 use super::rotations::{Predict, Spin, angular_velocities, predict_orientations};
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
@@ -35,7 +36,10 @@ impl<const L: usize> Phases<L> {
     /// The phases compiled for the baseline instruction set.
     pub const PORTABLE: Self = Self {
         begin: |g, s| begin_substep(g, s, predict_orientations),
-        match_shape: |g, landing| match_shape(g, landing, super::polar::extract_rotation, orientation_terms),
+        match_shape: |g, landing| {
+            let groups = GroupFns { full: matching::match_group::<L, true>, tip: matching::match_group::<L, false> };
+            match_shape(g, landing, &groups, orientation_terms)
+        },
         solve_lengths: |g, lanes, warm| solve_lengths(g, lanes, warm, &Passes::PORTABLE),
         finish: |g| finish_substep(g, angular_velocities),
         capture: output::capture,
@@ -203,7 +207,7 @@ pub fn finish_substep<const L: usize>(g: &mut LaneGroup<L>, spin: Spin<L>) {
 pub fn match_shape<const L: usize>(
     g: &mut LaneGroup<L>,
     landing: f32,
-    polar: fn(&M3<L>, &mut Q<L>, f32) -> M3<L>,
+    groups: &GroupFns<L>,
     orientation_terms: OrientationTerms<L>,
 ) {
     let n = g.n;
@@ -228,38 +232,52 @@ pub fn match_shape<const L: usize>(
     // those terms can all be taken before the sweep (a loop of its own, which keeps the sweep's registers
     // free); only the lower member's, updated by the group before, is taken in the sweep.
     orientation_terms(&qp[2..], &qbar_inv[2..], ow, &mut terms[2..]);
+    let stiffness = Stiffness { orientation_weight: ow, alpha, alpha64 };
+    // The tip's group has no upper member: this stands in for it, neither read nor written.
+    let mut spare = DV3::ZERO;
     for i in 2..n {
-        let lo = i - 1;
-        let full = i + 1 < n;
-        let [r_lo, r_mid, r_hi] = offsets[i];
-        let m_lo = orientation_term(qp, qbar_inv, lo, ow);
-        let m_mid = terms[i];
-        // The position terms relative to the middle particle (`rod::match_shape`).
-        let (c, a) = if full {
-            let hi = i + 1;
-            let m_hi = terms[hi];
-            let c = (DV3::ZERO + p[lo] + p[i] + p[hi]) / 3.0;
-            let a = m_lo
-                .add(M3::outer((p[lo] - p[i]).to_f32(), r_lo))
-                .add(m_mid)
-                .add(m_hi)
-                .add(M3::outer((p[hi] - p[i]).to_f32(), r_hi));
-            (c, a)
-        } else {
-            let c = (DV3::ZERO + p[lo] + p[i]) / 2.0;
-            let a = m_lo.add(M3::outer((p[lo] - p[i]).to_f32(), r_lo)).add(m_mid);
-            (c, a)
-        };
-        // In place: a copy of the rotation made for the call went through the stack both ways.
-        let frame = polar(&a, &mut group_rotation[i], landing);
-        let rotation = group_rotation[i];
-        p[lo] = pull_to_goal(p[lo], c, frame.mul_vec3(r_lo), alpha64);
-        p[i] = pull_to_goal(p[i], c, frame.mul_vec3(r_mid), alpha64);
-        if full {
-            p[i + 1] = pull_to_goal(p[i + 1], c, frame.mul_vec3(r_hi), alpha64);
+        let (below, above) = p.split_at_mut(i);
+        let (middle, above) = above.split_first_mut().expect("a middle member");
+        let lower = &mut below[i - 1];
+        let (qp_below, qp_above) = qp.split_at_mut(i);
+        let lower_turn = [&qp_below[i - 1], &qbar_inv[i - 1]];
+        let (rotation, qbar, qp) = (&mut group_rotation[i], &qbar[i], &mut qp_above[0]);
+        match above.first_mut() {
+            Some(upper) => (groups.full)(
+                lower,
+                middle,
+                upper,
+                &offsets[i],
+                lower_turn,
+                [&terms[i], &terms[i + 1]],
+                rotation,
+                qbar,
+                qp,
+                &stiffness,
+                landing,
+            ),
+            None => (groups.tip)(
+                lower,
+                middle,
+                &mut spare,
+                &offsets[i],
+                lower_turn,
+                [&terms[i], &terms[i]],
+                rotation,
+                qbar,
+                qp,
+                &stiffness,
+                landing,
+            ),
         }
-        qp[i] = qp[i].nlerp_shorter(rotation.mul(qbar[i]), alpha);
     }
+}
+
+/// [`matching::match_group`] compiled for the instruction set at hand, for the groups of three members and
+/// the tip's group of two.
+pub struct GroupFns<const L: usize> {
+    pub full: GroupFn<L>,
+    pub tip: GroupFn<L>,
 }
 
 /// [`orientation_terms`] compiled for the instruction set at hand (`mod.rs`).
@@ -276,12 +294,6 @@ pub fn orientation_terms<const L: usize>(qp: &[Q<L>], qbar_inv: &[Q<L>], weight:
         // 280 000 terms), 208 in a build without the barrier (not in the repository).
         std::hint::black_box(());
     }
-}
-
-/// A member's orientation term of the group matrix.
-#[inline(always)]
-fn orientation_term<const L: usize>(qp: &[Q<L>], qbar_inv: &[Q<L>], j: usize, weight: F<L>) -> M3<L> {
-    rotation_term(qp[j], qbar_inv[j], weight)
 }
 
 /// The orientation term of a member whose predicted rotation is `qp`: its turn from rest as a matrix, weighted.

@@ -30,6 +30,7 @@ mod contacts;
 mod group;
 mod kernel;
 mod lengths;
+mod matching;
 mod output;
 mod polar;
 mod prefetch;
@@ -46,7 +47,8 @@ use super::math::Transform;
 use super::reach::Reach;
 use super::rod::ChainConstants;
 use group::{GroupSettings, LaneChain, LaneGroup};
-use kernel::Phases;
+use kernel::{GroupFns, Phases};
+use matching::Stiffness;
 use lengths::{ForwardPass, Passes};
 use simd::{D, DV3, F, M3, Mask, Q, V3};
 
@@ -261,7 +263,7 @@ impl LaneSolver {
 
 /// The kernel's phases compiled for `$target` where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $polar:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
+    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $group_full:ident, $group_tip:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
         #[multiversion(targets($target))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
             kernel::begin_substep(g, s, $predict)
@@ -279,7 +281,7 @@ macro_rules! wide_phases {
 
         #[multiversion(targets($target))]
         fn $match_shape(g: &mut LaneGroup<$lanes>, landing: f32) {
-            kernel::match_shape(g, landing, $polar, $terms)
+            kernel::match_shape(g, landing, &GroupFns { full: $group_full, tip: $group_tip }, $terms)
         }
 
         #[multiversion(targets($target))]
@@ -287,9 +289,40 @@ macro_rules! wide_phases {
             kernel::orientation_terms(qp, qbar_inv, weight, terms)
         }
 
+        #[allow(clippy::too_many_arguments)]
         #[multiversion(targets($target))]
-        fn $polar(a: &M3<$lanes>, q: &mut Q<$lanes>, landing: f32) -> M3<$lanes> {
-            polar::extract_rotation(a, q, landing)
+        fn $group_full(
+            lower: &mut DV3<$lanes>,
+            middle: &mut DV3<$lanes>,
+            upper: &mut DV3<$lanes>,
+            offsets: &[V3<$lanes>; 3],
+            lower_turn: [&Q<$lanes>; 2],
+            terms: [&M3<$lanes>; 2],
+            rotation: &mut Q<$lanes>,
+            qbar: &Q<$lanes>,
+            qp: &mut Q<$lanes>,
+            stiffness: &Stiffness<$lanes>,
+            landing: f32,
+        ) {
+            matching::match_group::<$lanes, true>(lower, middle, upper, offsets, lower_turn, terms, rotation, qbar, qp, stiffness, landing)
+        }
+
+        #[allow(clippy::too_many_arguments)]
+        #[multiversion(targets($target))]
+        fn $group_tip(
+            lower: &mut DV3<$lanes>,
+            middle: &mut DV3<$lanes>,
+            upper: &mut DV3<$lanes>,
+            offsets: &[V3<$lanes>; 3],
+            lower_turn: [&Q<$lanes>; 2],
+            terms: [&M3<$lanes>; 2],
+            rotation: &mut Q<$lanes>,
+            qbar: &Q<$lanes>,
+            qp: &mut Q<$lanes>,
+            stiffness: &Stiffness<$lanes>,
+            landing: f32,
+        ) {
+            matching::match_group::<$lanes, false>(lower, middle, upper, offsets, lower_turn, terms, rotation, qbar, qp, stiffness, landing)
         }
 
         #[multiversion(targets($target))]
@@ -360,7 +393,8 @@ wide_phases!(
     "x86_64+avx2",
     begin8,
     match_shape8,
-    polar8,
+    group_full8,
+    group_tip8,
     terms8,
     solve_lengths8,
     PASSES8,
@@ -379,7 +413,8 @@ wide_phases!(
     "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq",
     begin16,
     match_shape16,
-    polar16,
+    group_full16,
+    group_tip16,
     terms16,
     solve_lengths16,
     PASSES16,
@@ -397,7 +432,8 @@ wide_phases!(
     "x86_64+avx2",
     begin4,
     match_shape4,
-    polar4,
+    group_full4,
+    group_tip4,
     terms4,
     solve_lengths4,
     PASSES4,

@@ -12,13 +12,10 @@
 
 use glam::{Quat, Vec3};
 
-use super::scalar::{Quaternion, Vec, length_squared, mul};
+use super::scalar::{Mat, Vec, from_quat, length_squared, mul};
 use super::simd::{M3, Mask, Q, V3};
 use crate::core::polar::{CONVERGED_ANGLE, LONG_TURN, MAX_NEWTON_ANGLE, MIN_PIVOT};
 use crate::core::rod::POLAR_ITERATIONS;
-
-/// Columns.
-type Mat = [Vec; 3];
 
 /// Improves every lane's `q` towards the rotation part of its `a`; a lane stops changing once it has
 /// converged or its Newton step has landed (shorter than `landing`: `polar::landing_angle`). Returns the
@@ -110,16 +107,6 @@ fn newton_step(s: &Mat, g: Vec, trace: f32, muller: Vec, landing: f32) -> (Vec, 
     let newton = definite & (step_squared <= MAX_NEWTON_ANGLE * MAX_NEWTON_ANGLE);
     let lands = newton & (step_squared < landing * landing);
     (if newton { step } else { muller }, lands)
-}
-
-/// `M3::from_quat`.
-#[inline(always)]
-fn from_quat([x, y, z, w]: Quaternion) -> Mat {
-    let (x2, y2, z2) = (x + x, y + y, z + z);
-    let (xx, xy, xz) = (x * x2, x * y2, x * z2);
-    let (yy, yz, zz) = (y * y2, y * z2, z * z2);
-    let (wx, wy, wz) = (w * x2, w * y2, w * z2);
-    [[1.0 - (yy + zz), xy + wz, xz - wy], [xy - wz, 1.0 - (xx + zz), yz + wx], [xz + wy, yz - wx, 1.0 - (xx + yy)]]
 }
 
 /// `M3::transpose_mul`: `r^T v`.

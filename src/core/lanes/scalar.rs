@@ -6,6 +6,8 @@
 pub type Vec = [f32; 3];
 /// A quaternion, `x, y, z, w`.
 pub type Quaternion = [f32; 4];
+/// A 3x3 matrix by columns.
+pub type Mat = [Vec; 3];
 
 #[inline(always)]
 pub fn length_squared(v: Vec) -> f32 {
@@ -101,4 +103,14 @@ pub fn log_series(q: Quaternion) -> (Vec, bool) {
     let in_range = (q[3] > 0.0) & (s2 <= q[3] * q[3] * 0.04) & (s2 >= 1e-16);
     let tiny = s2 < 1e-16;
     (if in_range { series } else { [0.0; 3] }, !(in_range | tiny))
+}
+
+/// `M3::from_quat`.
+#[inline(always)]
+pub fn from_quat([x, y, z, w]: Quaternion) -> Mat {
+    let (x2, y2, z2) = (x + x, y + y, z + z);
+    let (xx, xy, xz) = (x * x2, x * y2, x * z2);
+    let (yy, yz, zz) = (y * y2, y * z2, z * z2);
+    let (wx, wy, wz) = (w * x2, w * y2, w * z2);
+    [[1.0 - (yy + zz), xy + wz, xz - wy], [xy - wz, 1.0 - (xx + zz), yz + wx], [xz + wy, yz - wx, 1.0 - (xx + yy)]]
 }

@@ -454,6 +454,8 @@ impl<const L: usize> Q<L> {
 }
 
 impl<const L: usize> M3<L> {
+    pub const ZERO: Self = Self { x_axis: V3::ZERO, y_axis: V3::ZERO, z_axis: V3::ZERO };
+
     /// The rotation matrix of unit quaternions.
     #[inline(always)]
     pub fn from_quat(q: Q<L>) -> Self {
@@ -469,24 +471,21 @@ impl<const L: usize> M3<L> {
         }
     }
 
-    /// `u v^T`.
+    /// Lane `lane`'s matrix, by columns.
     #[inline(always)]
-    pub fn outer(u: V3<L>, v: V3<L>) -> Self {
-        Self { x_axis: u.scale(v.x), y_axis: u.scale(v.y), z_axis: u.scale(v.z) }
+    pub fn get(&self, lane: usize) -> [[f32; 3]; 3] {
+        [self.x_axis.get(lane), self.y_axis.get(lane), self.z_axis.get(lane)]
     }
 
     #[inline(always)]
-    pub fn add(self, o: Self) -> Self {
-        Self { x_axis: self.x_axis + o.x_axis, y_axis: self.y_axis + o.y_axis, z_axis: self.z_axis + o.z_axis }
+    pub fn set(&mut self, lane: usize, columns: [[f32; 3]; 3]) {
+        self.x_axis.set(lane, columns[0]);
+        self.y_axis.set(lane, columns[1]);
+        self.z_axis.set(lane, columns[2]);
     }
 
     #[inline(always)]
     pub fn scale(self, s: F<L>) -> Self {
         Self { x_axis: self.x_axis.scale(s), y_axis: self.y_axis.scale(s), z_axis: self.z_axis.scale(s) }
-    }
-
-    #[inline(always)]
-    pub fn mul_vec3(self, v: V3<L>) -> V3<L> {
-        self.x_axis.scale(v.x) + self.y_axis.scale(v.y) + self.z_axis.scale(v.z)
     }
 }

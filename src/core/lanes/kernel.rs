@@ -7,7 +7,7 @@
 use super::contacts;
 use super::group::LaneGroup;
 use super::lengths::{Passes, solve_lengths};
-use super::matching::{self, GroupFn, Stiffness};
+use super::matching::{self, Stiffness};
 use super::output;
 use super::rotations::{Predict, Spin, angular_velocities, predict_orientations};
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
@@ -36,10 +36,7 @@ impl<const L: usize> Phases<L> {
     /// The phases compiled for the baseline instruction set.
     pub const PORTABLE: Self = Self {
         begin: |g, s| begin_substep(g, s, predict_orientations),
-        match_shape: |g, landing| {
-            let groups = GroupFns { full: matching::match_group::<L, true>, tip: matching::match_group::<L, false> };
-            match_shape(g, landing, &groups, orientation_terms)
-        },
+        match_shape: |g, landing| match_shape(g, landing, sweep, orientation_terms),
         solve_lengths: |g, lanes, warm| solve_lengths(g, lanes, warm, &Passes::PORTABLE),
         finish: |g| finish_substep(g, angular_velocities),
         capture: output::capture,
@@ -207,7 +204,7 @@ pub fn finish_substep<const L: usize>(g: &mut LaneGroup<L>, spin: Spin<L>) {
 pub fn match_shape<const L: usize>(
     g: &mut LaneGroup<L>,
     landing: f32,
-    groups: &GroupFns<L>,
+    sweep: SweepFn<L>,
     orientation_terms: OrientationTerms<L>,
 ) {
     let n = g.n;
@@ -233,6 +230,29 @@ pub fn match_shape<const L: usize>(
     // free); only the lower member's, updated by the group before, is taken in the sweep.
     orientation_terms(&qp[2..], &qbar_inv[2..], ow, &mut terms[2..]);
     let stiffness = Stiffness { orientation_weight: ow, alpha, alpha64 };
+    sweep(p, qp, qbar, qbar_inv, offsets, terms, group_rotation, &stiffness, landing);
+}
+
+/// The sweep's groups after the root's ([`matching::match_group`]), every buffer cut to the joint count. A
+/// function of its own, compiled per instruction set (`mod.rs`), that takes every buffer as a separate slice:
+/// only so does the compiler know they do not overlap, which it must to vectorise the groups' lane loops
+/// (inlined into [`match_shape`], whose buffers are fields of the group, the loops ran lane by lane).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn sweep<const L: usize>(
+    p: &mut [DV3<L>],
+    qp: &mut [Q<L>],
+    qbar: &[Q<L>],
+    qbar_inv: &[Q<L>],
+    offsets: &[[V3<L>; 3]],
+    terms: &[M3<L>],
+    group_rotation: &mut [Q<L>],
+    stiffness: &Stiffness<L>,
+    landing: f32,
+) {
+    let n = p.len();
+    let (qp, qbar, qbar_inv, offsets, terms, group_rotation) =
+        (&mut qp[..n], &qbar[..n], &qbar_inv[..n], &offsets[..n], &terms[..n], &mut group_rotation[..n]);
     // The tip's group has no upper member: this stands in for it, neither read nor written.
     let mut spare = DV3::ZERO;
     for i in 2..n {
@@ -243,7 +263,7 @@ pub fn match_shape<const L: usize>(
         let lower_turn = [&qp_below[i - 1], &qbar_inv[i - 1]];
         let (rotation, qbar, qp) = (&mut group_rotation[i], &qbar[i], &mut qp_above[0]);
         match above.first_mut() {
-            Some(upper) => (groups.full)(
+            Some(upper) => matching::match_group::<L, true>(
                 lower,
                 middle,
                 upper,
@@ -253,10 +273,10 @@ pub fn match_shape<const L: usize>(
                 rotation,
                 qbar,
                 qp,
-                &stiffness,
+                stiffness,
                 landing,
             ),
-            None => (groups.tip)(
+            None => matching::match_group::<L, false>(
                 lower,
                 middle,
                 &mut spare,
@@ -266,19 +286,16 @@ pub fn match_shape<const L: usize>(
                 rotation,
                 qbar,
                 qp,
-                &stiffness,
+                stiffness,
                 landing,
             ),
         }
     }
 }
 
-/// [`matching::match_group`] compiled for the instruction set at hand, for the groups of three members and
-/// the tip's group of two.
-pub struct GroupFns<const L: usize> {
-    pub full: GroupFn<L>,
-    pub tip: GroupFn<L>,
-}
+/// [`sweep`] compiled for the instruction set at hand.
+pub type SweepFn<const L: usize> =
+    fn(&mut [DV3<L>], &mut [Q<L>], &[Q<L>], &[Q<L>], &[[V3<L>; 3]], &[M3<L>], &mut [Q<L>], &Stiffness<L>, f32);
 
 /// [`orientation_terms`] compiled for the instruction set at hand (`mod.rs`).
 pub type OrientationTerms<const L: usize> = fn(&[Q<L>], &[Q<L>], F<L>, &mut [M3<L>]);

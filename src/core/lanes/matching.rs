@@ -1,14 +1,14 @@
-//! The body of shape matching's sweep (`kernel::match_shape`) for one group: two loops over the lanes whose
-//! bodies are one lane's scalar code (the group matrix and centre before the polar decomposition; the pulls
-//! towards the goals and the middle member's orientation after it) around [`polar::extract_rotation`]. The
-//! same work written with the lane types' operations, in the sweep's own function, ran a fifth of its
-//! instructions 128-bit wide and a quarter on the stack. The arithmetic is those operations', in the same
-//! order: the same bits.
+//! The body of shape matching's sweep (`kernel::match_shape`) for one group, as loops over the lanes whose
+//! bodies are one lane's scalar code, each loop in one precision: the centre and the members' spans (double),
+//! the group matrix (single), the polar decomposition ([`polar::extract_rotation`]), the turned rest offsets
+//! and the middle member's orientation (single), the pulls (double). Written with the lane types' operations,
+//! the sweep ran a fifth of its instructions 128-bit wide and a quarter on the stack; with a loop mixing the
+//! two precisions the compiler vectorised it 4 lanes at a time, its single-precision half in 128-bit
+//! registers (48 % of the sweep's instructions, `tools/instruction_mix.py`). The arithmetic is the lane
+//! types' operations in their order: the same bits.
 //!
-//! One function per group, compiled per instruction set (`mod.rs`) and taking every buffer as a separate
-//! reference: only across such a call does the compiler know the buffers do not overlap, which it must to
-//! vectorise the lane loops (inlined into the sweep they ran lane by lane, as [`lengths`](super::lengths)
-//! found for its passes).
+//! The sweep that runs the groups (`kernel::sweep`) is a function of its own taking every buffer as a separate
+//! slice, for the compiler to vectorise these loops (see there).
 
 use super::polar;
 use super::scalar::{Mat, Quaternion, Vec, dot4, from_quat, mul};
@@ -23,22 +23,6 @@ pub struct Stiffness<const L: usize> {
     pub alpha: F<L>,
     pub alpha64: D<L>,
 }
-
-/// [`match_group`] for groups of three members (`true`) or the tip's group of two, compiled for the instruction
-/// set at hand.
-pub type GroupFn<const L: usize> = fn(
-    &mut DV3<L>,
-    &mut DV3<L>,
-    &mut DV3<L>,
-    &[V3<L>; 3],
-    [&Q<L>; 2],
-    [&M3<L>; 2],
-    &mut Q<L>,
-    &Q<L>,
-    &mut Q<L>,
-    &Stiffness<L>,
-    f32,
-);
 
 /// One group of the sweep: its members `lower`, `middle` and (`FULL`) `upper` pulled towards the rest offsets
 /// `offsets` turned by the group's rotation, which `rotation` holds from the last pass and takes from the
@@ -61,8 +45,7 @@ pub fn match_group<const L: usize, const FULL: bool>(
     stiffness: &Stiffness<L>,
     landing: f32,
 ) {
-    // Each lane loop holds one precision: a loop mixing them is vectorised 4 lanes at a time, its
-    // single-precision half in 128-bit registers.
+    // Each lane loop holds one precision (see the module's documentation).
     let mut c = DV3::ZERO;
     let mut to_members = [V3::ZERO; 2];
     centre_and_spans::<L, FULL>(lower, middle, upper, &mut c, &mut to_members);

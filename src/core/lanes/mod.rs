@@ -47,9 +47,9 @@ use super::math::Transform;
 use super::reach::Reach;
 use super::rod::ChainConstants;
 use group::{GroupSettings, LaneChain, LaneGroup};
-use kernel::{GroupFns, Phases};
-use matching::Stiffness;
+use kernel::Phases;
 use lengths::{ForwardPass, Passes};
+use matching::Stiffness;
 use simd::{D, DV3, F, M3, Mask, Q, V3};
 
 /// Which solver steps the chains.
@@ -263,7 +263,7 @@ impl LaneSolver {
 
 /// The kernel's phases compiled for `$target` where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $group_full:ident, $group_tip:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
+    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $sweep:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
         #[multiversion(targets($target))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
             kernel::begin_substep(g, s, $predict)
@@ -281,7 +281,7 @@ macro_rules! wide_phases {
 
         #[multiversion(targets($target))]
         fn $match_shape(g: &mut LaneGroup<$lanes>, landing: f32) {
-            kernel::match_shape(g, landing, &GroupFns { full: $group_full, tip: $group_tip }, $terms)
+            kernel::match_shape(g, landing, $sweep, $terms)
         }
 
         #[multiversion(targets($target))]
@@ -291,38 +291,18 @@ macro_rules! wide_phases {
 
         #[allow(clippy::too_many_arguments)]
         #[multiversion(targets($target))]
-        fn $group_full(
-            lower: &mut DV3<$lanes>,
-            middle: &mut DV3<$lanes>,
-            upper: &mut DV3<$lanes>,
-            offsets: &[V3<$lanes>; 3],
-            lower_turn: [&Q<$lanes>; 2],
-            terms: [&M3<$lanes>; 2],
-            rotation: &mut Q<$lanes>,
-            qbar: &Q<$lanes>,
-            qp: &mut Q<$lanes>,
+        fn $sweep(
+            p: &mut [DV3<$lanes>],
+            qp: &mut [Q<$lanes>],
+            qbar: &[Q<$lanes>],
+            qbar_inv: &[Q<$lanes>],
+            offsets: &[[V3<$lanes>; 3]],
+            terms: &[M3<$lanes>],
+            group_rotation: &mut [Q<$lanes>],
             stiffness: &Stiffness<$lanes>,
             landing: f32,
         ) {
-            matching::match_group::<$lanes, true>(lower, middle, upper, offsets, lower_turn, terms, rotation, qbar, qp, stiffness, landing)
-        }
-
-        #[allow(clippy::too_many_arguments)]
-        #[multiversion(targets($target))]
-        fn $group_tip(
-            lower: &mut DV3<$lanes>,
-            middle: &mut DV3<$lanes>,
-            upper: &mut DV3<$lanes>,
-            offsets: &[V3<$lanes>; 3],
-            lower_turn: [&Q<$lanes>; 2],
-            terms: [&M3<$lanes>; 2],
-            rotation: &mut Q<$lanes>,
-            qbar: &Q<$lanes>,
-            qp: &mut Q<$lanes>,
-            stiffness: &Stiffness<$lanes>,
-            landing: f32,
-        ) {
-            matching::match_group::<$lanes, false>(lower, middle, upper, offsets, lower_turn, terms, rotation, qbar, qp, stiffness, landing)
+            kernel::sweep(p, qp, qbar, qbar_inv, offsets, terms, group_rotation, stiffness, landing)
         }
 
         #[multiversion(targets($target))]
@@ -393,8 +373,7 @@ wide_phases!(
     "x86_64+avx2",
     begin8,
     match_shape8,
-    group_full8,
-    group_tip8,
+    sweep8,
     terms8,
     solve_lengths8,
     PASSES8,
@@ -413,8 +392,7 @@ wide_phases!(
     "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq",
     begin16,
     match_shape16,
-    group_full16,
-    group_tip16,
+    sweep16,
     terms16,
     solve_lengths16,
     PASSES16,
@@ -432,8 +410,7 @@ wide_phases!(
     "x86_64+avx2",
     begin4,
     match_shape4,
-    group_full4,
-    group_tip4,
+    sweep4,
     terms4,
     solve_lengths4,
     PASSES4,

@@ -51,6 +51,12 @@ pub fn solve_lengths<const L: usize>(
     // `Start::Cold` on the others (their first pass, under no multipliers, computes the cold pass's values).
     let started = warm.map_or(Mask([false; L]), |slot| g.warm[slot].remembered.and(lanes));
     match warm {
+        Some(slot) if started.all() => {
+            let history = &g.warm[slot];
+            for ((mu, &last), &before) in g.mu[..m].iter_mut().zip(&history.last[..m]).zip(&history.before[..m]) {
+                *mu = last.zip(before, MultiplierHistory::start);
+            }
+        }
         Some(slot) if started.any() => {
             let history = &g.warm[slot];
             for ((mu, &last), &before) in g.mu[..m].iter_mut().zip(&history.last[..m]).zip(&history.before[..m]) {
@@ -93,7 +99,9 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
         let pass = forward_pass(g, corrected, passes);
         let converged = active.and(pass.converged(previous_worst));
         if converged.any() {
-            if corrected {
+            if corrected && converged.all() {
+                g.p[1..=m].copy_from_slice(&g.corrected[1..=m]);
+            } else if corrected {
                 for (p, &corrected) in g.p[1..=m].iter_mut().zip(&g.corrected[1..=m]) {
                     *p = DV3::select(converged, corrected, *p);
                 }
@@ -135,10 +143,11 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
         let stepping = stepping.and(active);
         let mut next = D::splat(0.0);
         let (c_prime, d_prime) = (&g.c_prime[..m], &g.d_prime[..m]);
+        let every_lane = stepping.all();
         for (((step, mu), &c), &d) in g.step[..m].iter_mut().zip(&mut g.mu[..m]).zip(c_prime).zip(d_prime).rev() {
             next = d - c * next;
             *step = next;
-            *mu = D::select(stepping, *mu + next, *mu);
+            *mu = if every_lane { *mu + next } else { D::select(stepping, *mu + next, *mu) };
         }
         active = active.and(restart.or(next.is_finite()));
         // `inextensible::error_after_step`: lanes whose step lands within the tolerance take its positions
@@ -164,6 +173,13 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
 fn learn<const L: usize>(g: &mut LaneGroup<L>, slot: usize, m: usize, solved: Mask<L>) {
     let history = &mut g.warm[slot];
     let remembered = history.remembered;
+    if solved.all() && remembered.all() {
+        // The history moves on one solve: the last multipliers become the ones before.
+        std::mem::swap(&mut history.last, &mut history.before);
+        history.last[..m].copy_from_slice(&g.mu[..m]);
+        history.remembered = solved;
+        return;
+    }
     for ((&mu, last), before) in g.mu[..m].iter().zip(&mut history.last[..m]).zip(&mut history.before[..m]) {
         *before = D::select(solved, D::select(remembered, *last, mu), *before);
         *last = D::select(solved, mu, *last);
@@ -215,10 +231,11 @@ fn error_after_step<const L: usize>(g: &LaneGroup<L>, m: usize) -> D<L> {
 #[inline(always)]
 fn apply_multipliers<const L: usize>(g: &mut LaneGroup<L>, m: usize, lanes: Mask<L>) {
     let (d, mu, p) = (&g.start_bonds[..m], &g.mu[..m], &mut g.p[1..=m]);
+    let every_lane = lanes.all();
     for k in 0..m {
         let pulled = d[k].scale(mu[k]);
         let shift = if k + 1 < m { pulled - d[k + 1].scale(mu[k + 1]) } else { pulled };
-        p[k] = DV3::select(lanes, p[k] + shift, p[k]);
+        p[k] = if every_lane { p[k] + shift } else { DV3::select(lanes, p[k] + shift, p[k]) };
     }
 }
 

@@ -229,6 +229,12 @@ impl<const L: usize> Mask<L> {
     pub fn any(self) -> bool {
         self.0.iter().any(|&b| b)
     }
+
+    /// Every lane: callers take a plain update instead of a blend, which costs three operations a vector.
+    #[inline(always)]
+    pub fn all(self) -> bool {
+        self.0.iter().all(|&b| b)
+    }
 }
 
 /// `L` single-precision 3-vectors.

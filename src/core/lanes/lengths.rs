@@ -24,16 +24,18 @@ type DVec = [f64; 3];
 pub struct Passes<const L: usize> {
     pub first: FirstPass<L>,
     pub corrected: CorrectedPass<L>,
+    pub after_step: AfterStep<L>,
 }
 
 pub type FirstPass<const L: usize> =
     fn(&[DV3<L>], &[DV3<L>], &[D<L>], &[D<L>], &mut [D<L>], &mut [D<L>], &mut ForwardPass<L>);
 pub type CorrectedPass<const L: usize> =
     fn(&[DV3<L>], &mut [DV3<L>], &[D<L>], &[DV3<L>], &[D<L>], &[D<L>], &mut [D<L>], &mut [D<L>], &mut ForwardPass<L>);
+pub type AfterStep<const L: usize> = fn(&[DV3<L>], &mut [DV3<L>], &[D<L>], &[D<L>], &[DV3<L>], &[D<L>]) -> D<L>;
 
 impl<const L: usize> Passes<L> {
     /// The passes compiled for the baseline instruction set.
-    pub const PORTABLE: Self = Self { first: first_pass, corrected: corrected_pass };
+    pub const PORTABLE: Self = Self { first: first_pass, corrected: corrected_pass, after_step };
 }
 
 /// The direct solve on the lanes of `lanes`, from the multiplier history `warm` (a slot of `g.warm`) or from
@@ -96,15 +98,11 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
     let mut previous_worst = D::splat(f64::INFINITY);
     for iteration in 0..MAX_NEWTON_ITERATIONS {
         let corrected = iteration > 0 || started.any();
-        let pass = forward_pass(g, corrected, passes);
+        let pass = forward_pass(g, iteration, corrected, passes);
         let converged = active.and(pass.converged(previous_worst));
         if converged.any() {
-            if corrected && converged.all() {
-                g.p[1..=m].copy_from_slice(&g.corrected[1..=m]);
-            } else if corrected {
-                for (p, &corrected) in g.p[1..=m].iter_mut().zip(&g.corrected[1..=m]) {
-                    *p = DV3::select(converged, corrected, *p);
-                }
+            if corrected {
+                take_corrected(g, m, converged);
             }
             solved = solved.or(converged);
             active = active.and(converged.not());
@@ -150,13 +148,15 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
             *mu = if every_lane { *mu + next } else { D::select(stepping, *mu + next, *mu) };
         }
         active = active.and(restart.or(next.is_finite()));
-        // `inextensible::error_after_step`: lanes whose step lands within the tolerance take its positions
+        // The positions under the new multipliers, which the next pass reads, and
+        // `inextensible::error_after_step`: lanes whose step lands within the tolerance take those positions
         // without the pass that would confirm it.
+        let after = positions_after_step(g, m, passes);
         let near = stepping.and(active).and(pass.worst.le(D::splat(LANDING_GATE)));
         if near.any() {
-            let landed = near.and(error_after_step(g, m).le(D::splat(TOLERANCE)));
+            let landed = near.and(after.le(D::splat(TOLERANCE)));
             if landed.any() {
-                apply_multipliers(g, m, landed);
+                take_corrected(g, m, landed);
                 solved = solved.or(landed);
                 active = active.and(landed.not());
             }
@@ -203,51 +203,42 @@ fn largest_error<const L: usize>(g: &LaneGroup<L>, m: usize) -> D<L> {
     D(worst)
 }
 
-/// `inextensible::error_after_step` on every lane, from `g.step`. Lane by lane within each bond, as the passes:
-/// written with whole-group operations, the compiler vectorised the loop over the bonds instead (two bonds per
-/// 128-bit register, every value gathered), and this function took more instructions than both passes.
+/// `p` takes the positions of `g.corrected` on the lanes of `lanes`.
 #[inline(always)]
-fn error_after_step<const L: usize>(g: &LaneGroup<L>, m: usize) -> D<L> {
-    let (d, step, inv_l2) = (&g.start_bonds[..m], &g.step[..m], &g.inverse_length_squared[..m]);
-    let mut worst = [0.0; L];
-    let mut below = DV3::<L>::ZERO;
-    for k in 0..m {
-        let upper = (k + 1).min(m - 1);
-        let end = k + 1 == m;
-        let (own, own_step, next, next_step, inv) = (&d[k], &step[k], &d[upper], &step[upper], &inv_l2[k]);
-        for lane in 0..L {
-            let above = bond_shift(own.get(lane), own_step.0[lane], next.get(lane), next_step.0[lane], end);
-            let e = sub(above, below.get(lane));
-            let error = dot(e, e) * inv.0[lane];
-            // As the scalar code: a NaN error is ignored here (its lane's step was not finite: not active).
-            worst[lane] = if error > worst[lane] { error } else { worst[lane] };
-            below.set(lane, above);
+fn take_corrected<const L: usize>(g: &mut LaneGroup<L>, m: usize, lanes: Mask<L>) {
+    if lanes.all() {
+        g.p[1..=m].copy_from_slice(&g.corrected[1..=m]);
+    } else {
+        for (p, &corrected) in g.p[1..=m].iter_mut().zip(&g.corrected[1..=m]) {
+            *p = DV3::select(lanes, corrected, *p);
         }
     }
-    D(worst)
 }
 
-/// The positions under the multipliers on the lanes of `lanes`, as [`corrected_pass`] computes them.
+/// After a Newton step: [`after_step`] on the group's buffers.
 #[inline(always)]
-fn apply_multipliers<const L: usize>(g: &mut LaneGroup<L>, m: usize, lanes: Mask<L>) {
-    let (d, mu, p) = (&g.start_bonds[..m], &g.mu[..m], &mut g.p[1..=m]);
-    let every_lane = lanes.all();
-    for k in 0..m {
-        let pulled = d[k].scale(mu[k]);
-        let shift = if k + 1 < m { pulled - d[k + 1].scale(mu[k + 1]) } else { pulled };
-        p[k] = if every_lane { p[k] + shift } else { DV3::select(lanes, p[k] + shift, p[k]) };
-    }
+fn positions_after_step<const L: usize>(g: &mut LaneGroup<L>, m: usize, passes: &Passes<L>) -> D<L> {
+    let (d, inv_l2) = (&g.start_bonds[..m], &g.inverse_length_squared[..m]);
+    (passes.after_step)(&g.p[..=m], &mut g.corrected[..=m], &g.mu[..m], &g.step[..m], d, inv_l2)
 }
 
 /// One pass root to tip: the bonds under the current multipliers (`corrected`; the bonds of `p` itself
 /// before the first step), their errors, and the forward elimination of the Newton system.
 #[inline(always)]
-fn forward_pass<const L: usize>(g: &mut LaneGroup<L>, corrected: bool, passes: &Passes<L>) -> ForwardPass<L> {
+fn forward_pass<const L: usize>(
+    g: &mut LaneGroup<L>,
+    iteration: usize,
+    corrected: bool,
+    passes: &Passes<L>,
+) -> ForwardPass<L> {
     let m = g.n - 1;
     let mut pass = ForwardPass::new();
     let (d, l2, inv_l2) = (&g.start_bonds[..m], &g.length_squared[..m], &g.inverse_length_squared[..m]);
     let (c_prime, d_prime) = (&mut g.c_prime[..m], &mut g.d_prime[..m]);
-    if corrected {
+    if iteration > 0 {
+        // `after_step` left the positions under the current multipliers in `corrected`: the bonds of those.
+        (passes.first)(&g.corrected[..=m], d, l2, inv_l2, c_prime, d_prime, &mut pass);
+    } else if corrected {
         (passes.corrected)(&g.p[..=m], &mut g.corrected[..=m], &g.mu[..m], d, l2, inv_l2, c_prime, d_prime, &mut pass);
     } else {
         (passes.first)(&g.p[..=m], d, l2, inv_l2, c_prime, d_prime, &mut pass);
@@ -304,7 +295,8 @@ macro_rules! each_bond {
     }};
 }
 
-/// The first pass: the bonds of `p`.
+/// A pass over the bonds of `p` as they are: the first (no multipliers yet) and every pass after a step (the
+/// positions [`after_step`] moved).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn first_pass<const L: usize>(
@@ -365,6 +357,47 @@ pub fn corrected_pass<const L: usize>(
             pass.row(lane, sub(moved, start.get(lane)), &bond, c_row, d_row);
         }
     });
+}
+
+/// After a Newton step of the multipliers: the positions under the new multipliers `mu` (`p` moved as
+/// [`corrected_pass`] moves it, into `corrected`, which the next pass reads and a landing step takes), and
+/// `inextensible::error_after_step` from the step `step`, returned. One pass over the bonds for both, lane by
+/// lane within each bond as the other passes (and for their reason): the two were separate loops before, and
+/// the positions were computed again by the next pass.
+#[inline(always)]
+pub fn after_step<const L: usize>(
+    p: &[DV3<L>],
+    corrected: &mut [DV3<L>],
+    mu: &[D<L>],
+    step: &[D<L>],
+    d: &[DV3<L>],
+    inv_l2: &[D<L>],
+) -> D<L> {
+    let m = d.len();
+    // Every slice cut to its length up front, as in `corrected_pass`.
+    let (p, corrected, mu, step, inv_l2) = (&p[..=m], &mut corrected[..=m], &mu[..m], &step[..m], &inv_l2[..m]);
+    corrected[0] = p[0];
+    let mut worst = [0.0; L];
+    let mut below = DV3::<L>::ZERO;
+    each_bond!(m, |k, ends| {
+        let last = ends.1;
+        let upper = (k + 1).min(m - 1);
+        let (own, next, own_step, next_step, inv) = (&d[k], &d[upper], &step[k], &step[upper], &inv_l2[k]);
+        let (own_mu, next_mu, tip) = (&mu[k], &mu[upper], &p[k + 1]);
+        let moved_tip = &mut corrected[k + 1];
+        for lane in 0..L {
+            let (own_bond, next_bond) = (own.get(lane), next.get(lane));
+            let above = bond_shift(own_bond, own_step.0[lane], next_bond, next_step.0[lane], last);
+            let e = sub(above, below.get(lane));
+            let error = dot(e, e) * inv.0[lane];
+            // As the scalar code: a NaN error is ignored here (its lane's step was not finite: not active).
+            worst[lane] = if error > worst[lane] { error } else { worst[lane] };
+            below.set(lane, above);
+            let shift = bond_shift(own_bond, own_mu.0[lane], next_bond, next_mu.0[lane], last);
+            moved_tip.set(lane, add(tip.get(lane), shift));
+        }
+    });
+    D(worst)
 }
 
 /// What one bond's row of the pass reads.

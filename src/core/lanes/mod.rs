@@ -263,7 +263,7 @@ impl LaneSolver {
 
 /// The kernel's phases compiled for `$target` where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $sweep:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
+    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $sweep:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $after:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
         #[multiversion(targets($target))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
             kernel::begin_substep(g, s, $predict)
@@ -339,7 +339,19 @@ macro_rules! wide_phases {
             lengths::corrected_pass(p, corrected, mu, d, l2, inv_l2, c_prime, d_prime, pass)
         }
 
-        const $passes: Passes<$lanes> = Passes { first: $first, corrected: $corrected };
+        #[multiversion(targets($target))]
+        fn $after(
+            p: &[DV3<$lanes>],
+            corrected: &mut [DV3<$lanes>],
+            mu: &[D<$lanes>],
+            step: &[D<$lanes>],
+            d: &[DV3<$lanes>],
+            inv_l2: &[D<$lanes>],
+        ) -> D<$lanes> {
+            lengths::after_step(p, corrected, mu, step, d, inv_l2)
+        }
+
+        const $passes: Passes<$lanes> = Passes { first: $first, corrected: $corrected, after_step: $after };
 
         #[multiversion(targets($target))]
         fn $finish(g: &mut LaneGroup<$lanes>) {
@@ -379,6 +391,7 @@ wide_phases!(
     PASSES8,
     first_pass8,
     corrected_pass8,
+    after_step8,
     finish8,
     predict8,
     spin8,
@@ -398,6 +411,7 @@ wide_phases!(
     PASSES16,
     first_pass16,
     corrected_pass16,
+    after_step16,
     finish16,
     predict16,
     spin16,
@@ -416,6 +430,7 @@ wide_phases!(
     PASSES4,
     first_pass4,
     corrected_pass4,
+    after_step4,
     finish4,
     predict4,
     spin4,

@@ -167,7 +167,7 @@ impl Chain {
     /// How deep (m) a joint must have been inside a collider at the start of a substep to count as overlapping
     /// since then (`ContactInput::slop`): a share of the chain's shortest segment.
     pub(crate) fn contact_slop(&self) -> f32 {
-        CONTACT_SLOP * self.frame.lengths.iter().copied().fold(f32::INFINITY, f32::min)
+        CONTACT_SLOP * self.shortest_segment
     }
 
     /// A contact pass whose corrections stay below this (m) has settled (`rod::substep`'s final rounds).

@@ -1,9 +1,9 @@
 //! The direct inextensibility solve (`inextensible::newton_along_directions`) on every lane of a group.
 //!
-//! The forward pass, which does most of the work, is written as loops over the lanes whose bodies are one
+//! The passes over the bonds, which do most of the work, are written as loops over the lanes whose bodies are one
 //! lane's scalar arithmetic, for the reason given in [`polar`](super::polar): with 8-lane array operations
 //! on double-precision 3-vectors the vectoriser grouped the 24 values of a vector across its components
-//! (4-, 2- and 1-wide pieces), and most of the pass ran in 128-bit or scalar instructions. The arithmetic is
+//! (4-, 2- and 1-wide pieces), and most of a pass ran in 128-bit or scalar instructions. The arithmetic is
 //! the same, operation for operation, so the bits are the same.
 
 use super::group::LaneGroup;
@@ -15,7 +15,8 @@ use crate::core::warm_start::MultiplierHistory;
 
 type DVec = [f64; 3];
 
-/// The two kinds of forward pass, as functions compiled for the instruction set at hand (`mod.rs`). They
+/// The passes over the bonds (the two kinds of forward pass, and [`after_step`] after each Newton step), as
+/// functions compiled for the instruction set at hand (`mod.rs`). They
 /// must stay real functions taking every buffer as a separate slice: only across such a call does the
 /// compiler know the buffers do not overlap, which it must to vectorise the lane loops (inlined, with the
 /// slices cut from the group's `Vec`s, the loops stayed scalar). As functions they run 70 % 256-bit

@@ -58,8 +58,21 @@ impl Peak {
         } else {
             (divider(div_f32x8, sqrt_f32x8), divider(div_f64x8, sqrt_f64x8))
         };
+        let scalar_f32 = best(f32x1);
+        // Even 4-lane registers (the portable copy's SSE2 or NEON) run twice the scalar rate; below that a SIMD
+        // probe's code did not vectorise (its accumulators went to memory: see `chains!`), and every bound
+        // derived from it would be wrong.
+        assert!(
+            simd_f32 > 2.0 * scalar_f32 && simd_f64 > scalar_f32,
+            "the {}-lane SIMD probes ran at f32 {:.1} and f64 {:.1} G lane operations/s against a scalar {:.1}: \
+             their code did not vectorise (disassemble f32x16 / f32x8 in benches/support/peak.rs)",
+            if sixteen { 16 } else { 8 },
+            simd_f32 / 1e9,
+            simd_f64 / 1e9,
+            scalar_f32 / 1e9
+        );
         Self {
-            scalar_f32: best(f32x1),
+            scalar_f32,
             simd_f32,
             simd_f64,
             lanes: if sixteen { 16 } else { 8 },
@@ -86,23 +99,32 @@ fn best_of(run: fn(u64) -> (u64, f64), rounds: u64, passes: usize) -> f64 {
     best
 }
 
-/// `$chains` independent accumulators of type `$vector` (as many as the vector registers hold), half multiplied
-/// and half added to each round, with the intrinsics `$mul` and `$add` written out so that no compiler pass
-/// can regroup them (the vectoriser, left to itself, spilled or shuffled some widths). Evaluates to the lane
-/// operations run and a value that depends on every one of them.
+/// Independent accumulators, one per name in the list (as many as the vector registers hold), the first of each
+/// pair multiplied and the second added to each round, with the operations `$mul` and `$add` (intrinsics, or
+/// lane loops the vectoriser compiles to one instruction per register) written out so that no compiler pass can
+/// regroup them. Named locals, not an array indexed in a loop: an array's accumulators could stay in memory,
+/// each round a load, the operation and a store (rustc 1.95 did so with the 16-lane arrays, and the probes
+/// measured a fifth of the core's rate). Evaluates to the lane operations run and a value that depends on every
+/// one of them.
 macro_rules! chains {
-    ($rounds:expr, $vector:ty, $elem:ty, $lanes:literal, $chains:literal, $splat:expr, $mul:expr, $add:expr, $sum:expr) => {{
-        let mut acc: [$vector; $chains] = std::array::from_fn(|k| $splat(1.0 + k as $elem));
+    ($rounds:expr, $elem:ty, $lanes:literal, $splat:expr, $mul:expr, $add:expr, $sum:expr, [$($m:ident $a:ident),+]) => {{
+        let mut start: $elem = 0.0;
         // Opaque start values: the compiler can neither merge chains nor fold the rounds.
-        acc = black_box(acc);
+        $(
+            start += 1.0;
+            let mut $m = black_box($splat(start));
+            start += 1.0;
+            let mut $a = black_box($splat(start));
+        )+
         let (factor, step) = ($splat(black_box(0.999_999_9)), $splat(black_box(1e-7)));
         for _ in 0..$rounds {
-            for k in (0..$chains).step_by(2) {
-                acc[k] = $mul(acc[k], factor);
-                acc[k + 1] = $add(acc[k + 1], step);
-            }
+            $(
+                $m = $mul($m, factor);
+                $a = $add($a, step);
+            )+
         }
-        ($rounds * $chains * $lanes, acc.iter().map($sum).sum::<f64>())
+        let chains: u64 = 0 $(+ { let _ = stringify!($m); 2 })+;
+        ($rounds * chains * $lanes, 0.0 $(+ $sum(&$m) + $sum(&$a))+)
     }};
 }
 
@@ -117,14 +139,13 @@ fn f32x16(rounds: u64) -> (u64, f64) {
     // vectoriser compiles these to one register per chain.
     chains!(
         rounds,
-        [f32; 16],
         f32,
         16,
-        12,
         |x| [x; 16],
         lanewise::<f32, 16>(|a, b| a * b),
         lanewise::<f32, 16>(|a, b| a + b),
-        |v: &[f32; 16]| v.iter().map(|&x| f64::from(x)).sum::<f64>()
+        |v: &[f32; 16]| v.iter().map(|&x| f64::from(x)).sum::<f64>(),
+        [m0 a0, m1 a1, m2 a2, m3 a3, m4 a4, m5 a5]
     )
 }
 
@@ -134,21 +155,25 @@ fn f32x16(rounds: u64) -> (u64, f64) {
 fn f64x16(rounds: u64) -> (u64, f64) {
     chains!(
         rounds,
-        [f64; 16],
         f64,
         16,
-        12,
         |x| [x; 16],
         lanewise::<f64, 16>(|a, b| a * b),
         lanewise::<f64, 16>(|a, b| a + b),
-        |v: &[f64; 16]| v.iter().sum::<f64>()
+        |v: &[f64; 16]| v.iter().sum::<f64>(),
+        [m0 a0, m1 a1, m2 a2, m3 a3, m4 a4, m5 a5]
     )
 }
 
 /// `op` lane by lane.
 #[inline(always)]
 fn lanewise<T: Copy, const L: usize>(op: impl Fn(T, T) -> T) -> impl Fn([T; L], [T; L]) -> [T; L] {
-    move |a, b| std::array::from_fn(|i| op(a[i], b[i]))
+    move |mut a, b| {
+        for (a, b) in a.iter_mut().zip(b) {
+            *a = op(*a, b);
+        }
+        a
+    }
 }
 
 /// The lanes of an AVX2 register summed (only to keep every chain's result alive), for code that has
@@ -177,19 +202,18 @@ fn f32x8(rounds: u64) -> (u64, f64) {
     match_target! {
         "x86_64+avx2" => {
             use std::arch::x86_64::*;
-            chains!(rounds, __m256, f32, 8, 12, _mm256_set1_ps, _mm256_mul_ps, _mm256_add_ps, sum_ps!())
+            chains!(rounds, f32, 8, _mm256_set1_ps, _mm256_mul_ps, _mm256_add_ps, sum_ps!(), [m0 a0, m1 a1, m2 a2, m3 a3, m4 a4, m5 a5])
         }
         // The portable kernel (SSE2, NEON): arrays, few enough chains for 16 128-bit registers.
         _ => chains!(
             rounds,
-            [f32; 8],
             f32,
             8,
-            6,
             |x| [x; 8],
             lanewise::<f32, 8>(|a, b| a * b),
             lanewise::<f32, 8>(|a, b| a + b),
-            |v: &[f32; 8]| v.iter().map(|&x| f64::from(x)).sum::<f64>()
+            |v: &[f32; 8]| v.iter().map(|&x| f64::from(x)).sum::<f64>(),
+            [m0 a0, m1 a1, m2 a2]
         ),
     }
 }
@@ -199,18 +223,17 @@ fn f64x8(rounds: u64) -> (u64, f64) {
     match_target! {
         "x86_64+avx2" => {
             use std::arch::x86_64::*;
-            chains!(rounds, __m256d, f64, 4, 12, _mm256_set1_pd, _mm256_mul_pd, _mm256_add_pd, sum_pd!())
+            chains!(rounds, f64, 4, _mm256_set1_pd, _mm256_mul_pd, _mm256_add_pd, sum_pd!(), [m0 a0, m1 a1, m2 a2, m3 a3, m4 a4, m5 a5])
         }
         _ => chains!(
             rounds,
-            [f64; 8],
             f64,
             8,
-            2,
             |x| [x; 8],
             lanewise::<f64, 8>(|a, b| a * b),
             lanewise::<f64, 8>(|a, b| a + b),
-            |v: &[f64; 8]| v.iter().sum::<f64>()
+            |v: &[f64; 8]| v.iter().sum::<f64>(),
+            [m0 a0]
         ),
     }
 }
@@ -218,37 +241,57 @@ fn f64x8(rounds: u64) -> (u64, f64) {
 /// The scalar solver's code is compiled for the baseline instruction set.
 #[inline(never)]
 fn f32x1(rounds: u64) -> (u64, f64) {
-    chains!(rounds, f32, f32, 1, 12, |x: f32| x, |a: f32, b: f32| a * b, |a: f32, b: f32| a + b, |&v: &f32| f64::from(
-        v
-    ))
+    chains!(
+        rounds,
+        f32,
+        1,
+        |x: f32| x,
+        |a: f32, b: f32| a * b,
+        |a: f32, b: f32| a + b,
+        |&v: &f32| f64::from(v),
+        [m0 a0, m1 a1, m2 a2, m3 a3, m4 a4, m5 a5]
+    )
 }
 
-/// `$chains` independent accumulators of type `$vector`, each replaced every round by `$op(accumulator, factor)`
+/// Independent accumulators, one per name in the list, each replaced every round by `$op(accumulator, factor)`
 /// (a division by a factor near 1, or a square root, which keeps the values near 1: no special values). As
-/// [`chains!`], evaluates to the lane operations run and a value that depends on every one of them.
+/// [`chains!`] (and named locals for its reason), evaluates to the lane operations run and a value that depends
+/// on every one of them.
 macro_rules! divider_chains {
-    ($rounds:expr, $vector:ty, $elem:ty, $lanes:literal, $chains:literal, $splat:expr, $op:expr, $sum:expr) => {{
-        let mut acc: [$vector; $chains] = std::array::from_fn(|k| $splat(1.0 + k as $elem));
-        acc = black_box(acc);
+    ($rounds:expr, $elem:ty, $lanes:literal, $splat:expr, $op:expr, $sum:expr, [$($a:ident)+]) => {{
+        let mut start: $elem = 0.0;
+        $(
+            start += 1.0;
+            let mut $a = black_box($splat(start));
+        )+
         let factor = $splat(black_box(0.999_999_9));
         for _ in 0..$rounds {
-            for a in &mut acc {
-                *a = $op(*a, factor);
-            }
+            $(
+                $a = $op($a, factor);
+            )+
         }
-        ($rounds * $chains * $lanes, acc.iter().map($sum).sum::<f64>())
+        let chains: u64 = 0 $(+ { let _ = stringify!($a); 1 })+;
+        ($rounds * chains * $lanes, 0.0 $(+ $sum(&$a))+)
     }};
 }
 
 /// A division, and a square root (ignoring its second argument), lane by lane.
 #[inline(always)]
-fn lane_division<T: Copy + std::ops::Div<Output = T>, const L: usize>(a: [T; L], b: [T; L]) -> [T; L] {
-    std::array::from_fn(|i| a[i] / b[i])
+fn lane_division<T: Copy + std::ops::Div<Output = T>, const L: usize>(mut a: [T; L], b: [T; L]) -> [T; L] {
+    for (a, b) in a.iter_mut().zip(b) {
+        *a = *a / b;
+    }
+    a
 }
 
 macro_rules! lane_root {
     ($elem:ty, $lanes:literal) => {
-        |a: [$elem; $lanes], _: [$elem; $lanes]| -> [$elem; $lanes] { a.map(<$elem>::sqrt) }
+        |mut a: [$elem; $lanes], _: [$elem; $lanes]| -> [$elem; $lanes] {
+            for a in &mut a {
+                *a = a.sqrt();
+            }
+            a
+        }
     };
 }
 
@@ -259,10 +302,15 @@ macro_rules! divider16 {
             "x86_64+avx512f+avx512vl+avx512bw+avx512dq+avx512cd+avx512ifma+avx512vbmi+avx512vbmi2+avx512vnni+avx512bitalg+avx512vpopcntdq+gfni+vaes+vpclmulqdq"
         ))]
         fn $name(rounds: u64) -> (u64, f64) {
-            divider_chains!(rounds, [$elem; 16], $elem, 16, 12, |x| [x; 16], $op, |v: &[$elem; 16]| v
-                .iter()
-                .map(|&x| x as f64)
-                .sum::<f64>())
+            divider_chains!(
+                rounds,
+                $elem,
+                16,
+                |x| [x; 16],
+                $op,
+                |v: &[$elem; 16]| v.iter().map(|&x| x as f64).sum::<f64>(),
+                [d0 d1 d2 d3 d4 d5 d6 d7 d8 d9 d10 d11]
+            )
         }
     };
 }
@@ -273,48 +321,53 @@ divider16!(div_f64x16, f64, lane_division::<f64, 16>);
 divider16!(sqrt_f64x16, f64, lane_root!(f64, 16));
 
 /// A division or square root probe for the 8-lane kernel: AVX2 intrinsics where the CPU has them (`$lanes` per
-/// register, 12 chains), arrays of 8 in the portable copy (`$portable_chains` of them), as [`f32x8`] and
+/// register, 12 chains), arrays of 8 in the portable copy (the `$portable_chains` named), as [`f32x8`] and
 /// [`f64x8`]. `$avx2` and `$sum` may name `std::arch::x86_64` items.
 macro_rules! divider8 {
-    ($name:ident, $vector:ty, $elem:ty, $lanes:literal, $splat:expr, $avx2:expr, $sum:expr, $portable_chains:literal, $portable:expr) => {
+    ($name:ident, $elem:ty, $lanes:literal, $splat:expr, $avx2:expr, $sum:expr, [$($portable_chains:ident)+], $portable:expr) => {
         #[multiversion(targets("x86_64+avx2"))]
         fn $name(rounds: u64) -> (u64, f64) {
             match_target! {
                 "x86_64+avx2" => {
                     use std::arch::x86_64::*;
-                    divider_chains!(rounds, $vector, $elem, $lanes, 12, $splat, $avx2, $sum)
+                    divider_chains!(rounds, $elem, $lanes, $splat, $avx2, $sum, [d0 d1 d2 d3 d4 d5 d6 d7 d8 d9 d10 d11])
                 }
-                _ => divider_chains!(rounds, [$elem; 8], $elem, 8, $portable_chains, |x| [x; 8], $portable, |v: &[$elem; 8]| v
-                    .iter()
-                    .map(|&x| x as f64)
-                    .sum::<f64>()),
+                _ => divider_chains!(
+                    rounds,
+                    $elem,
+                    8,
+                    |x| [x; 8],
+                    $portable,
+                    |v: &[$elem; 8]| v.iter().map(|&x| x as f64).sum::<f64>(),
+                    [$($portable_chains)+]
+                ),
             }
         }
     };
 }
 
-divider8!(div_f32x8, __m256, f32, 8, _mm256_set1_ps, _mm256_div_ps, sum_ps!(), 6, lane_division::<f32, 8>);
-divider8!(sqrt_f32x8, __m256, f32, 8, _mm256_set1_ps, |a, _| _mm256_sqrt_ps(a), sum_ps!(), 6, lane_root!(f32, 8));
-divider8!(div_f64x8, __m256d, f64, 4, _mm256_set1_pd, _mm256_div_pd, sum_pd!(), 2, lane_division::<f64, 8>);
-divider8!(sqrt_f64x8, __m256d, f64, 4, _mm256_set1_pd, |a, _| _mm256_sqrt_pd(a), sum_pd!(), 2, lane_root!(f64, 8));
+divider8!(div_f32x8, f32, 8, _mm256_set1_ps, _mm256_div_ps, sum_ps!(), [p0 p1 p2 p3 p4 p5], lane_division::<f32, 8>);
+divider8!(sqrt_f32x8, f32, 8, _mm256_set1_ps, |a, _| _mm256_sqrt_ps(a), sum_ps!(), [p0 p1 p2 p3 p4 p5], lane_root!(f32, 8));
+divider8!(div_f64x8, f64, 4, _mm256_set1_pd, _mm256_div_pd, sum_pd!(), [p0 p1], lane_division::<f64, 8>);
+divider8!(sqrt_f64x8, f64, 4, _mm256_set1_pd, |a, _| _mm256_sqrt_pd(a), sum_pd!(), [p0 p1], lane_root!(f64, 8));
 
 /// The scalar solver's code is compiled for the baseline instruction set.
 #[inline(never)]
 fn div_f32x1(rounds: u64) -> (u64, f64) {
-    divider_chains!(rounds, f32, f32, 1, 12, |x: f32| x, |a: f32, b: f32| a / b, |&v: &f32| f64::from(v))
+    divider_chains!(rounds, f32, 1, |x: f32| x, |a: f32, b: f32| a / b, |&v: &f32| f64::from(v), [d0 d1 d2 d3 d4 d5 d6 d7 d8 d9 d10 d11])
 }
 
 #[inline(never)]
 fn sqrt_f32x1(rounds: u64) -> (u64, f64) {
-    divider_chains!(rounds, f32, f32, 1, 12, |x: f32| x, |a: f32, _: f32| a.sqrt(), |&v: &f32| f64::from(v))
+    divider_chains!(rounds, f32, 1, |x: f32| x, |a: f32, _: f32| a.sqrt(), |&v: &f32| f64::from(v), [d0 d1 d2 d3 d4 d5 d6 d7 d8 d9 d10 d11])
 }
 
 #[inline(never)]
 fn div_f64x1(rounds: u64) -> (u64, f64) {
-    divider_chains!(rounds, f64, f64, 1, 12, |x: f64| x, |a: f64, b: f64| a / b, |&v: &f64| v)
+    divider_chains!(rounds, f64, 1, |x: f64| x, |a: f64, b: f64| a / b, |&v: &f64| v, [d0 d1 d2 d3 d4 d5 d6 d7 d8 d9 d10 d11])
 }
 
 #[inline(never)]
 fn sqrt_f64x1(rounds: u64) -> (u64, f64) {
-    divider_chains!(rounds, f64, f64, 1, 12, |x: f64| x, |a: f64, _: f64| a.sqrt(), |&v: &f64| v)
+    divider_chains!(rounds, f64, 1, |x: f64| x, |a: f64, _: f64| a.sqrt(), |&v: &f64| v, [d0 d1 d2 d3 d4 d5 d6 d7 d8 d9 d10 d11])
 }

@@ -1,8 +1,14 @@
 //! Software prefetch: asking for the cache lines of data a loop will read a little later, so that it arrives
 //! while the loop works on what came before. Chains live in separate allocations (a dozen per chain), too
-//! many streams for the hardware prefetchers to follow: the lane solver's loads ([`super::lanes`]) and the
-//! engine's read-backs, which read each chain's pose long after the step wrote it, ask for them ahead.
-//! Prefetching changes no result, only when data arrives.
+//! many streams for the hardware prefetchers to follow: the engine's read-backs, which read each chain's pose
+//! long after the step wrote it, and the rest-shape updates ask for them a few chains ahead. Prefetching
+//! changes no result, only when data arrives.
+//!
+//! The lane solver asked for the whole next group's chains (about a thousand lines for 16 chains) and no
+//! longer does: on an AMD EPYC with AVX-512 that burst made the frame slower, not faster (a build without it,
+//! loading the chains with [`super::lanes`]' transposes, was 0.95x the time of one with it on `scene_cost 80
+//! 1000x16 lanes`, and 0.92x to 0.95x on 16384 x 16, which does not fit in the cache), while the read-backs'
+//! one chain at a time still pays (1.04x without it).
 
 use multiversion::multiversion;
 use multiversion::target::match_target;

@@ -5,6 +5,7 @@ use glam::{DVec3, Quat, Vec3, Vec3A};
 
 use super::contacts::LaneContacts;
 use super::simd::{D, DV3, F, M3, Mask, Q, V3};
+use super::transpose;
 use crate::core::buffers::reserve_total;
 use crate::core::collider::ColliderSweep;
 use crate::core::collision::SegmentBounds;
@@ -90,6 +91,12 @@ pub struct LaneGroup<const L: usize> {
     pub(super) local_current: Vec<(V3<L>, Q<L>)>,
     pub(super) output: Vec<(V3<L>, Q<L>)>,
     pub(super) bone_axes: Vec<V3<L>>,
+    /// The transposes' scratch ([`transpose`]): a quantity's numbers with a row per number and a lane per chain
+    /// (`rows32`, `rows64`), and with a row per chain (`lanes32`, `lanes64`: the store's way out).
+    rows32: Vec<[f32; L]>,
+    rows64: Vec<[f64; L]>,
+    lanes32: Vec<f32>,
+    lanes64: Vec<f64>,
     /// Each lane's contacts this step, and the lanes that have any.
     pub(super) contacts: Vec<LaneContacts>,
     pub(super) contact_lanes: Mask<L>,
@@ -187,6 +194,11 @@ impl<const L: usize> LaneGroup<L> {
             fit(v, n, (V3::ZERO, zero_q));
         }
         fit(&mut self.bone_axes, n, V3::ZERO);
+        // The widest quantity a transpose moves: the rest offsets, three 4-number vectors per joint (`Vec3A`).
+        fit(&mut self.rows32, 12 * n, [0.0; L]);
+        fit(&mut self.rows64, 3 * n, [0.0; L]);
+        fit(&mut self.lanes32, (RENDER_START + 3 * 7) * n * L, 0.0);
+        fit(&mut self.lanes64, 3 * n * L, 0.0);
         if self.contacts.len() < L {
             self.contacts.resize_with(L, LaneContacts::default);
         }
@@ -215,40 +227,41 @@ impl<const L: usize> LaneGroup<L> {
     /// lane would write all of the group's buffers, more than the L1 cache holds at 16 lanes.
     pub(crate) fn load(&mut self, chains: &[LaneChain<'_>; L]) {
         let n = self.n;
-        // Every chain's arrays cut to `n` up front, so the loops below index them without bounds checks.
-        let states = chains.each_ref().map(|c| {
-            let st = c.state;
-            (&st.x[..n], &st.v[..n], &st.q[..n], &st.w[..n], &st.group_rotation[..n])
-        });
-        let rests = chains.each_ref().map(|c| (&c.bone_axes[..n], &c.rest.orientations[..n], &c.offsets[..n]));
-        let rebases = chains.each_ref().map(|c| c.rebase);
-        let (x, v, q, w, group_rotation) =
-            (&mut self.x[..n], &mut self.v[..n], &mut self.q[..n], &mut self.w[..n], &mut self.group_rotation[..n]);
-        let (bone_axes, qbars, qbar_invs, offsets) =
-            (&mut self.bone_axes[..n], &mut self.qbar[..n], &mut self.qbar_inv[..n], &mut self.offsets[..n]);
-        for j in 0..n {
-            for (lane, st) in states.iter().enumerate() {
-                // `RodState::translate`'s addition, as the engine would have made it before the step.
-                let position = match rebases[lane] {
-                    Some(shift) => st.0[j] + shift,
-                    None => st.0[j],
-                };
-                x[j].set(lane, position.to_array());
-                v[j].set(lane, st.1[j].to_array());
-                q[j].set(lane, st.2[j].to_array());
-                w[j].set(lane, st.3[j].to_array());
-                group_rotation[j].set(lane, st.4[j].to_array());
+        let x = gather64(&mut self.rows64, chains.each_ref().map(|c| bytemuck::cast_slice(&c.state.x[..n])));
+        for (to, from) in self.x[..n].iter_mut().zip(x.chunks_exact(3)) {
+            (to.x.0, to.y.0, to.z.0) = (from[0], from[1], from[2]);
+        }
+        // `RodState::translate`'s addition, as the engine would have made it before the step.
+        for (lane, chain) in chains.iter().enumerate() {
+            if let Some(shift) = chain.rebase {
+                for x in &mut self.x[..n] {
+                    x.set(lane, (DVec3::from_array(x.get(lane)) + shift).to_array());
+                }
             }
-            for (lane, rest) in rests.iter().enumerate() {
-                bone_axes[j].set(lane, rest.0[j].to_array());
-                let qbar = rest.1[j];
-                qbars[j].set(lane, qbar.to_array());
-                qbar_invs[j].set(lane, qbar.inverse().to_array());
-                let [a, b, c] = rest.2[j];
-                let offsets = &mut offsets[j];
-                offsets[0].set(lane, a.to_array());
-                offsets[1].set(lane, b.to_array());
-                offsets[2].set(lane, c.to_array());
+        }
+        let v = gather32(&mut self.rows32, chains.each_ref().map(|c| bytemuck::cast_slice(&c.state.v[..n])));
+        rows_to_vectors(v, &mut self.v[..n]);
+        let w = gather32(&mut self.rows32, chains.each_ref().map(|c| bytemuck::cast_slice(&c.state.w[..n])));
+        rows_to_vectors(w, &mut self.w[..n]);
+        let q = gather32(&mut self.rows32, chains.each_ref().map(|c| bytemuck::cast_slice(&c.state.q[..n])));
+        rows_to_quaternions(q, &mut self.q[..n]);
+        let rotation =
+            gather32(&mut self.rows32, chains.each_ref().map(|c| bytemuck::cast_slice(&c.state.group_rotation[..n])));
+        rows_to_quaternions(rotation, &mut self.group_rotation[..n]);
+        let axes = gather32(&mut self.rows32, chains.each_ref().map(|c| bytemuck::cast_slice(&c.bone_axes[..n])));
+        rows_to_vectors(axes, &mut self.bone_axes[..n]);
+        let qbar =
+            gather32(&mut self.rows32, chains.each_ref().map(|c| bytemuck::cast_slice(&c.rest.orientations[..n])));
+        rows_to_quaternions(qbar, &mut self.qbar[..n]);
+        for (inverse, qbar) in self.qbar_inv[..n].iter_mut().zip(&self.qbar[..n]) {
+            // `Quat::inverse` of a unit quaternion: its conjugate (a sign flip, exact).
+            *inverse = Q { x: -qbar.x, y: -qbar.y, z: -qbar.z, w: qbar.w };
+        }
+        // Three `Vec3A` a joint: four numbers each, the fourth unused.
+        let offsets = gather32(&mut self.rows32, chains.each_ref().map(|c| bytemuck::cast_slice(&c.offsets[..n])));
+        for (to, from) in self.offsets[..n].iter_mut().zip(offsets.chunks_exact(12)) {
+            for (member, from) in to.iter_mut().zip(from.chunks_exact(4)) {
+                (member.x.0, member.y.0, member.z.0) = (from[0], from[1], from[2]);
             }
         }
         if self.substeps < 2 {
@@ -359,26 +372,45 @@ impl<const L: usize> LaneGroup<L> {
         rotation.set(lane, anchor.rotation.to_array());
     }
 
-    /// The particle state of `lane` into `state`.
-    pub(crate) fn store(&self, lane: usize, state: &mut RodState) {
+    /// Turns the particle state into a row per lane and quantity, for [`store`](Self::store) to copy out.
+    pub(crate) fn prepare_store(&mut self) {
         let n = self.n;
-        // Cut to `n` up front: no bounds checks in the loop.
-        let (x, q, v, w, group_rotation) = (
-            &mut state.x[..n],
-            &mut state.q[..n],
-            &mut state.v[..n],
-            &mut state.w[..n],
-            &mut state.group_rotation[..n],
-        );
-        let (lane_x, lane_q, lane_v, lane_w, lane_rotation) =
-            (&self.x[..n], &self.q[..n], &self.v[..n], &self.w[..n], &self.group_rotation[..n]);
-        for j in 0..n {
-            x[j] = DVec3::from_array(lane_x[j].get(lane));
-            q[j] = Quat::from_array(lane_q[j].get(lane));
-            v[j] = Vec3::from_array(lane_v[j].get(lane));
-            w[j] = Vec3::from_array(lane_w[j].get(lane));
-            group_rotation[j] = Quat::from_array(lane_rotation[j].get(lane));
+        let rows = &mut self.rows64[..3 * n];
+        for (to, from) in rows.chunks_exact_mut(3).zip(&self.x[..n]) {
+            (to[0], to[1], to[2]) = (from.x.0, from.y.0, from.z.0);
         }
+        transpose::scatter_f64(rows, &mut self.lanes64);
+        let [v, w, q, rotation] = store_regions(&mut self.lanes32, n, L);
+        vectors_to_lanes(&self.v[..n], &mut self.rows32, v);
+        vectors_to_lanes(&self.w[..n], &mut self.rows32, w);
+        quaternions_to_lanes(&self.q[..n], &mut self.rows32, q);
+        quaternions_to_lanes(&self.group_rotation[..n], &mut self.rows32, rotation);
+        // The render poses: 7 numbers a joint (position, rotation), a row per pose and lane.
+        let poses = &mut self.lanes32[RENDER_START * n * L..];
+        for (pose, lanes) in
+            [&self.local_previous, &self.local_current, &self.output].into_iter().zip(poses.chunks_exact_mut(7 * n * L))
+        {
+            let rows = &mut self.rows32[..7 * n];
+            for (to, (position, rotation)) in rows.chunks_exact_mut(7).zip(&pose[..n]) {
+                (to[0], to[1], to[2]) = (position.x.0, position.y.0, position.z.0);
+                (to[3], to[4], to[5], to[6]) = (rotation.x.0, rotation.y.0, rotation.z.0, rotation.w.0);
+            }
+            transpose::scatter_f32(rows, lanes);
+        }
+    }
+
+    /// The particle state of `lane` into `state` ([`prepare_store`](Self::prepare_store) first).
+    pub(crate) fn store(&mut self, lane: usize, state: &mut RodState) {
+        let n = self.n;
+        fn row(lanes: &[f32], lane: usize, width: usize) -> &[f32] {
+            &lanes[lane * width..(lane + 1) * width]
+        }
+        state.x[..n].copy_from_slice(bytemuck::cast_slice(&self.lanes64[lane * 3 * n..(lane + 1) * 3 * n]));
+        let [v, w, q, rotation] = store_regions(&mut self.lanes32, n, L);
+        state.v[..n].copy_from_slice(bytemuck::cast_slice(row(v, lane, 3 * n)));
+        state.w[..n].copy_from_slice(bytemuck::cast_slice(row(w, lane, 3 * n)));
+        state.q[..n].copy_from_slice(bytemuck::cast_slice(row(q, lane, 4 * n)));
+        state.group_rotation[..n].copy_from_slice(bytemuck::cast_slice(row(rotation, lane, 4 * n)));
         let memory = &mut state.solve_memory;
         memory.copy_streak_from(&self.memories[lane]);
         memory.set_learnt_at(self.h, self.solves());
@@ -405,15 +437,74 @@ impl<const L: usize> LaneGroup<L> {
         current: &mut [Transform],
         output: &mut [Transform],
     ) {
-        let transform = |(position, rotation): &(V3<L>, Q<L>)| {
-            Transform::new(Vec3::from_array(position.get(lane)), Quat::from_array(rotation.get(lane)))
-        };
-        for j in 0..self.n {
-            previous[j] = transform(&self.local_previous[j]);
-            current[j] = transform(&self.local_current[j]);
-            output[j] = transform(&self.output[j]);
+        let n = self.n;
+        let poses = &self.lanes32[RENDER_START * n * L..];
+        for (pose, to) in [previous, current, output].into_iter().enumerate() {
+            let row = &poses[(pose * L + lane) * 7 * n..][..7 * n];
+            for (to, from) in to[..n].iter_mut().zip(row.chunks_exact(7)) {
+                *to = Transform::new(Vec3::from_slice(&from[..3]), Quat::from_slice(&from[3..]));
+            }
         }
     }
+}
+
+/// Where the render poses start in `LaneGroup::lanes32` (numbers per joint and lane): after the particle
+/// state's 14 (`store_regions`).
+const RENDER_START: usize = 14;
+
+/// [`transpose::gather_f32`] of `sources` (one chain's numbers each, all as many) into `rows`.
+fn gather32<'r, const L: usize>(rows: &'r mut [[f32; L]], sources: [&[f32]; L]) -> &'r [[f32; L]] {
+    let rows = &mut rows[..sources[0].len()];
+    transpose::gather_f32(&sources, rows);
+    rows
+}
+
+/// As [`gather32`], in double precision.
+fn gather64<'r, const L: usize>(rows: &'r mut [[f64; L]], sources: [&[f64]; L]) -> &'r [[f64; L]] {
+    let rows = &mut rows[..sources[0].len()];
+    transpose::gather_f64(&sources, rows);
+    rows
+}
+
+/// Rows of `x, y, z` numbers, joint after joint, into vectors.
+fn rows_to_vectors<const L: usize>(rows: &[[f32; L]], vectors: &mut [V3<L>]) {
+    for (to, from) in vectors.iter_mut().zip(rows.chunks_exact(3)) {
+        (to.x.0, to.y.0, to.z.0) = (from[0], from[1], from[2]);
+    }
+}
+
+/// Rows of `x, y, z, w` numbers, joint after joint, into quaternions.
+fn rows_to_quaternions<const L: usize>(rows: &[[f32; L]], quaternions: &mut [Q<L>]) {
+    for (to, from) in quaternions.iter_mut().zip(rows.chunks_exact(4)) {
+        (to.x.0, to.y.0, to.z.0, to.w.0) = (from[0], from[1], from[2], from[3]);
+    }
+}
+
+/// The store's rows per lane (`LaneGroup::lanes32`) of the velocities, angular velocities, rotations and group
+/// rotations of `n` joints on `lanes` lanes.
+fn store_regions(lanes32: &mut [f32], n: usize, lanes: usize) -> [&mut [f32]; 4] {
+    let (v, rest) = lanes32.split_at_mut(3 * n * lanes);
+    let (w, rest) = rest.split_at_mut(3 * n * lanes);
+    let (q, rest) = rest.split_at_mut(4 * n * lanes);
+    [v, w, q, &mut rest[..4 * n * lanes]]
+}
+
+/// Vectors as rows of numbers (`rows`, scratch), then as a row per lane (`lanes`).
+fn vectors_to_lanes<const L: usize>(vectors: &[V3<L>], rows: &mut [[f32; L]], lanes: &mut [f32]) {
+    let rows = &mut rows[..3 * vectors.len()];
+    for (to, from) in rows.chunks_exact_mut(3).zip(vectors) {
+        (to[0], to[1], to[2]) = (from.x.0, from.y.0, from.z.0);
+    }
+    transpose::scatter_f32(rows, lanes);
+}
+
+/// Quaternions as rows of numbers (`rows`, scratch), then as a row per lane (`lanes`).
+fn quaternions_to_lanes<const L: usize>(quaternions: &[Q<L>], rows: &mut [[f32; L]], lanes: &mut [f32]) {
+    let rows = &mut rows[..4 * quaternions.len()];
+    for (to, from) in rows.chunks_exact_mut(4).zip(quaternions) {
+        (to[0], to[1], to[2], to[3]) = (from.x.0, from.y.0, from.z.0, from.w.0);
+    }
+    transpose::scatter_f32(rows, lanes);
 }
 
 #[cfg(test)]

@@ -9,8 +9,8 @@
 //!
 //! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group, whose phases are compiled one by one;
 //!   [`polar`], [`lengths`] and [`rotations`]: the parts written as loops over lanes, with one lane's
-//!   arithmetic in [`scalar`]; [`contacts`]: the contact pass, lane by lane; [`group`]: the buffers;
-//!   [`prefetch`]: the next group's chain data requested while a group runs.
+//!   arithmetic in [`scalar`]; [`contacts`]: the contact pass, lane by lane; [`group`]: the buffers, loaded from
+//!   the chains and stored back by [`transpose`].
 //! - The wide copies of the kernel are compiled for AVX2 (groups of 8 and 4) and AVX-512 (groups of 16) next
 //!   to the portable (SSE2) one and chosen at run time by CPU-feature detection ([`multiversion`]); no build
 //!   needs `target-cpu=native`.
@@ -33,10 +33,10 @@ mod lengths;
 mod matching;
 mod output;
 mod polar;
-mod prefetch;
 mod rotations;
 mod scalar;
 mod simd;
+mod transpose;
 
 use glam::DVec3;
 use multiversion::multiversion;
@@ -236,16 +236,9 @@ impl LaneSolver {
             let same = rest.iter().take_while(|j| j.key() == first.key()).count();
             let (mut run, tail) = rest.split_at(same);
             rest = tail;
-            let mut widths = group_widths(same, sixteen).peekable();
-            while let Some((count, width)) = widths.next() {
+            for (count, width) in group_widths(same, sixteen) {
                 let (group, remaining) = run.split_at(count);
                 run = remaining;
-                // The next group's chains arrive while this one runs (the first group of the next run: at most 16).
-                let (next, ahead) = match widths.peek() {
-                    Some(&(next_count, _)) => (run, next_count),
-                    None => (rest, 16),
-                };
-                prefetch::chains_of(chains, &next[..next.len().min(ahead)]);
                 let (group_fallbacks, group_pairs) = match (width, portable) {
                     (16, _) => run_group(&mut self.g16, chains, group, clock, reach, &WIDE16),
                     (8, false) => run_group(&mut self.g8, chains, group, clock, reach, &WIDE8),
@@ -513,6 +506,7 @@ fn run_group<const L: usize>(
         }
     }
     (phases.output)(g, clock.output_fraction);
+    g.prepare_store();
     for (lane, job) in jobs.iter().enumerate() {
         let chain = chains.at_mut(job.slot as usize).expect("live");
         g.store(lane, &mut chain.state);

@@ -97,6 +97,8 @@ pub struct LaneGroup<const L: usize> {
     rows64: Vec<[f64; L]>,
     lanes32: Vec<f32>,
     lanes64: Vec<f64>,
+    /// The multiplier history of a lane that remembers none (`load_warm_starts`).
+    zeros: Vec<f64>,
     /// Each lane's contacts this step, and the lanes that have any.
     pub(super) contacts: Vec<LaneContacts>,
     pub(super) contact_lanes: Mask<L>,
@@ -198,7 +200,9 @@ impl<const L: usize> LaneGroup<L> {
         fit(&mut self.rows32, 12 * n, [0.0; L]);
         fit(&mut self.rows64, 3 * n, [0.0; L]);
         fit(&mut self.lanes32, (RENDER_START + 3 * 7) * n * L, 0.0);
-        fit(&mut self.lanes64, 3 * n * L, 0.0);
+        // The positions, then the multiplier histories (two per slot).
+        fit(&mut self.lanes64, (3 + 2 * WARM_SLOTS) * n * L, 0.0);
+        fit(&mut self.zeros, n, 0.0);
         if self.contacts.len() < L {
             self.contacts.resize_with(L, LaneContacts::default);
         }
@@ -308,20 +312,27 @@ impl<const L: usize> LaneGroup<L> {
     fn load_warm_starts(&mut self, chains: &[LaneChain<'_>; L]) {
         let bonds = self.n - 1;
         let solves = self.solves();
-        for (lane, chain) in chains.iter().enumerate() {
-            let memory = &chain.state.solve_memory;
-            let applies = memory.warm_applies(self.h, solves);
-            for (warm, history) in self.warm.iter_mut().zip(&memory.warm) {
-                let remembered = applies && history.remembered() && history.last.len() == bonds;
-                warm.remembered.0[lane] = remembered;
-                if remembered {
-                    for (to, &from) in warm.last[..bonds].iter_mut().zip(&history.last) {
-                        to.0[lane] = from;
-                    }
-                    for (to, &from) in warm.before[..bonds].iter_mut().zip(&history.before) {
-                        to.0[lane] = from;
-                    }
-                }
+        let applies = chains.each_ref().map(|c| c.state.solve_memory.warm_applies(self.h, solves));
+        for (slot, warm) in self.warm.iter_mut().enumerate() {
+            let history = |lane: usize| &chains[lane].state.solve_memory.warm[slot];
+            let remembered = std::array::from_fn(|lane| {
+                applies[lane] && history(lane).remembered() && history(lane).last.len() == bonds
+            });
+            warm.remembered = Mask(remembered);
+            if !warm.remembered.any() {
+                continue;
+            }
+            // Lanes that remember nothing take zeros, which no solve reads (`lengths::solve_lengths` starts
+            // them from none).
+            let zeros = &self.zeros[..bonds];
+            let last = std::array::from_fn(|lane| if remembered[lane] { &history(lane).last[..bonds] } else { zeros });
+            for (to, from) in warm.last[..bonds].iter_mut().zip(gather64(&mut self.rows64, last)) {
+                to.0 = *from;
+            }
+            let before =
+                std::array::from_fn(|lane| if remembered[lane] { &history(lane).before[..bonds] } else { zeros });
+            for (to, from) in warm.before[..bonds].iter_mut().zip(gather64(&mut self.rows64, before)) {
+                to.0 = *from;
             }
         }
     }
@@ -379,7 +390,18 @@ impl<const L: usize> LaneGroup<L> {
         for (to, from) in rows.chunks_exact_mut(3).zip(&self.x[..n]) {
             (to[0], to[1], to[2]) = (from.x.0, from.y.0, from.z.0);
         }
-        transpose::scatter_f64(rows, &mut self.lanes64);
+        let (x_lanes, warm_lanes) = self.lanes64.split_at_mut(3 * n * L);
+        transpose::scatter_f64(rows, x_lanes);
+        // The multiplier histories: each slot's last and before, as `store` copies them.
+        let bonds = n - 1;
+        let histories = self.warm.iter().flat_map(|warm| [&warm.last, &warm.before]);
+        for (region, history) in histories.enumerate() {
+            let rows = &mut self.rows64[..bonds];
+            for (to, from) in rows.iter_mut().zip(&history[..bonds]) {
+                *to = from.0;
+            }
+            transpose::scatter_f64(rows, &mut warm_lanes[region * bonds * L..]);
+        }
         let [v, w, q, rotation] = store_regions(&mut self.lanes32, n, L);
         vectors_to_lanes(&self.v[..n], &mut self.rows32, v);
         vectors_to_lanes(&self.w[..n], &mut self.rows32, w);
@@ -414,14 +436,14 @@ impl<const L: usize> LaneGroup<L> {
         let memory = &mut state.solve_memory;
         memory.copy_streak_from(&self.memories[lane]);
         memory.set_learnt_at(self.h, self.solves());
-        for (warm, history) in self.warm.iter().zip(&mut memory.warm) {
-            if warm.remembered.0[lane] && history.last.len() == self.n - 1 {
-                for (to, from) in history.last.iter_mut().zip(&warm.last) {
-                    *to = from.0[lane];
-                }
-                for (to, from) in history.before.iter_mut().zip(&warm.before) {
-                    *to = from.0[lane];
-                }
+        let bonds = n - 1;
+        // `prepare_store`'s rows of the histories: each slot's last and before, a row per lane.
+        let rows = &self.lanes64[3 * n * L..];
+        let row = |region: usize| &rows[(region * L + lane) * bonds..][..bonds];
+        for (slot, (warm, history)) in self.warm.iter().zip(&mut memory.warm).enumerate() {
+            if warm.remembered.0[lane] && history.last.len() == bonds {
+                history.last.copy_from_slice(row(2 * slot));
+                history.before.copy_from_slice(row(2 * slot + 1));
                 history.remembered = true;
             } else {
                 history.forget();

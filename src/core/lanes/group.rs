@@ -226,9 +226,8 @@ impl<const L: usize> LaneGroup<L> {
         self.segment_bounds.reserve(n);
     }
 
-    /// Loads `chains[lane]` into every lane. Joint by joint across the lanes: the buffers of one joint (a few
-    /// cache lines per quantity) are written by every lane before the next joint's, where lane by lane every
-    /// lane would write all of the group's buffers, more than the L1 cache holds at 16 lanes.
+    /// Loads `chains[lane]` into every lane: quantity by quantity, each chain's array read as numbers and
+    /// transposed into rows of lanes ([`transpose`]), which the group's vectors take row by row.
     pub(crate) fn load(&mut self, chains: &[LaneChain<'_>; L]) {
         let n = self.n;
         let x = gather64(&mut self.rows64, chains.each_ref().map(|c| bytemuck::cast_slice(&c.state.x[..n])));
@@ -402,7 +401,9 @@ impl<const L: usize> LaneGroup<L> {
             }
             transpose::scatter_f64(rows, &mut warm_lanes[region * bonds * L..]);
         }
-        let [v, w, q, rotation] = store_regions(&mut self.lanes32, n, L);
+        let (v, rest) = self.lanes32.split_at_mut(3 * n * L);
+        let (w, rest) = rest.split_at_mut(3 * n * L);
+        let (q, rotation) = rest.split_at_mut(4 * n * L);
         vectors_to_lanes(&self.v[..n], &mut self.rows32, v);
         vectors_to_lanes(&self.w[..n], &mut self.rows32, w);
         quaternions_to_lanes(&self.q[..n], &mut self.rows32, q);
@@ -422,17 +423,21 @@ impl<const L: usize> LaneGroup<L> {
     }
 
     /// The particle state of `lane` into `state` ([`prepare_store`](Self::prepare_store) first).
-    pub(crate) fn store(&mut self, lane: usize, state: &mut RodState) {
+    pub(crate) fn store(&self, lane: usize, state: &mut RodState) {
         let n = self.n;
-        fn row(lanes: &[f32], lane: usize, width: usize) -> &[f32] {
-            &lanes[lane * width..(lane + 1) * width]
-        }
+        // `prepare_store`'s rows: the velocities, angular velocities, rotations and group rotations one after
+        // the other, each with `width` numbers a joint and a row per lane.
+        let mut start = 0;
+        let mut row = |width: usize| {
+            let row = &self.lanes32[start + lane * width * n..][..width * n];
+            start += width * n * L;
+            row
+        };
         state.x[..n].copy_from_slice(bytemuck::cast_slice(&self.lanes64[lane * 3 * n..(lane + 1) * 3 * n]));
-        let [v, w, q, rotation] = store_regions(&mut self.lanes32, n, L);
-        state.v[..n].copy_from_slice(bytemuck::cast_slice(row(v, lane, 3 * n)));
-        state.w[..n].copy_from_slice(bytemuck::cast_slice(row(w, lane, 3 * n)));
-        state.q[..n].copy_from_slice(bytemuck::cast_slice(row(q, lane, 4 * n)));
-        state.group_rotation[..n].copy_from_slice(bytemuck::cast_slice(row(rotation, lane, 4 * n)));
+        state.v[..n].copy_from_slice(bytemuck::cast_slice(row(3)));
+        state.w[..n].copy_from_slice(bytemuck::cast_slice(row(3)));
+        state.q[..n].copy_from_slice(bytemuck::cast_slice(row(4)));
+        state.group_rotation[..n].copy_from_slice(bytemuck::cast_slice(row(4)));
         let memory = &mut state.solve_memory;
         memory.copy_streak_from(&self.memories[lane]);
         memory.set_learnt_at(self.h, self.solves());
@@ -471,7 +476,7 @@ impl<const L: usize> LaneGroup<L> {
 }
 
 /// Where the render poses start in `LaneGroup::lanes32` (numbers per joint and lane): after the particle
-/// state's 14 (`store_regions`).
+/// state's 14 (`LaneGroup::prepare_store`).
 const RENDER_START: usize = 14;
 
 /// [`transpose::gather_f32`] of `sources` (one chain's numbers each, all as many) into `rows`.
@@ -500,15 +505,6 @@ fn rows_to_quaternions<const L: usize>(rows: &[[f32; L]], quaternions: &mut [Q<L
     for (to, from) in quaternions.iter_mut().zip(rows.chunks_exact(4)) {
         (to.x.0, to.y.0, to.z.0, to.w.0) = (from[0], from[1], from[2], from[3]);
     }
-}
-
-/// The store's rows per lane (`LaneGroup::lanes32`) of the velocities, angular velocities, rotations and group
-/// rotations of `n` joints on `lanes` lanes.
-fn store_regions(lanes32: &mut [f32], n: usize, lanes: usize) -> [&mut [f32]; 4] {
-    let (v, rest) = lanes32.split_at_mut(3 * n * lanes);
-    let (w, rest) = rest.split_at_mut(3 * n * lanes);
-    let (q, rest) = rest.split_at_mut(4 * n * lanes);
-    [v, w, q, &mut rest[..4 * n * lanes]]
 }
 
 /// Vectors as rows of numbers (`rows`, scratch), then as a row per lane (`lanes`).

@@ -3,11 +3,12 @@
 //! (`[joint][component][lane]`), so loading `L` chains turns an `L x K` matrix into its `K x L` transpose, and
 //! storing them turns it back.
 //!
-//! Number by number (a load and a store each, at a scattered address on one side) this took about 2 cycles a
-//! number: measured on an AMD EPYC with AVX-512 (groups of 16), a build that ran `LaneGroup::load` twice was
-//! 1.09x slower on `scene_cost 80 1000x16 lanes`. With AVX2 the transpose runs in 8 x 8 blocks of single- and
-//! 4 x 4 blocks of double-precision numbers, whole registers loaded, shuffled and stored. Moving numbers
-//! changes none of them: the same bits either way.
+//! Number by number (a load and a store each, at a scattered address on one side) this was dear: on an AMD
+//! EPYC with AVX-512 (groups of 16), a build that ran that `LaneGroup::load` twice, the second time from the
+//! cache, took 1.09x the time of `scene_cost 80 1000x16 lanes` (`tools/ab.sh --abba`). With AVX2 the transpose
+//! runs in 8 x 8 blocks of single- and 4 x 4 blocks of double-precision numbers, whole registers loaded,
+//! shuffled and stored; the portable copy, and the numbers after the last whole block, go number by number.
+//! Moving numbers changes none of them: the same bits either way.
 
 use multiversion::multiversion;
 use multiversion::target::match_target;
@@ -20,11 +21,7 @@ pub(crate) fn gather_f32<const L: usize>(sources: &[&[f32]; L], rows: &mut [[f32
         "x86_64+avx2" => if L.is_multiple_of(8) { avx2::gather_f32(&sources, rows) } else { 0 },
         _ => 0,
     };
-    for (k, row) in rows.iter_mut().enumerate().skip(done) {
-        for (value, source) in row.iter_mut().zip(&sources) {
-            *value = source[k];
-        }
-    }
+    gather_from(done, &sources, rows);
 }
 
 /// As [`gather_f32`], in double precision.
@@ -35,11 +32,7 @@ pub(crate) fn gather_f64<const L: usize>(sources: &[&[f64]; L], rows: &mut [[f64
         "x86_64+avx2" => if L.is_multiple_of(4) { avx2::gather_f64(&sources, rows) } else { 0 },
         _ => 0,
     };
-    for (k, row) in rows.iter_mut().enumerate().skip(done) {
-        for (value, source) in row.iter_mut().zip(&sources) {
-            *value = source[k];
-        }
-    }
+    gather_from(done, &sources, rows);
 }
 
 /// The way back: `lanes[lane * rows.len() + k] = rows[k][lane]`, each lane's numbers in a row of `lanes`.
@@ -54,11 +47,7 @@ pub(crate) fn scatter_f32<const L: usize>(rows: &[[f32; L]], lanes: &mut [f32]) 
         "x86_64+avx2" => if L.is_multiple_of(8) { avx2::scatter_f32(rows, lanes) } else { 0 },
         _ => 0,
     };
-    for (lane, out) in lanes.chunks_exact_mut(k_len).enumerate() {
-        for (value, row) in out.iter_mut().zip(rows).skip(done) {
-            *value = row[lane];
-        }
-    }
+    scatter_from(done, rows, lanes);
 }
 
 /// As [`scatter_f32`], in double precision.
@@ -73,7 +62,21 @@ pub(crate) fn scatter_f64<const L: usize>(rows: &[[f64; L]], lanes: &mut [f64]) 
         "x86_64+avx2" => if L.is_multiple_of(4) { avx2::scatter_f64(rows, lanes) } else { 0 },
         _ => 0,
     };
-    for (lane, out) in lanes.chunks_exact_mut(k_len).enumerate() {
+    scatter_from(done, rows, lanes);
+}
+
+/// The gather number by number, from row `done` on.
+fn gather_from<T: Copy, const L: usize>(done: usize, sources: &[&[T]; L], rows: &mut [[T; L]]) {
+    for (k, row) in rows.iter_mut().enumerate().skip(done) {
+        for (value, source) in row.iter_mut().zip(sources) {
+            *value = source[k];
+        }
+    }
+}
+
+/// The scatter number by number, from row `done` on (`lanes` holds a row of `rows.len()` numbers per lane).
+fn scatter_from<T: Copy, const L: usize>(done: usize, rows: &[[T; L]], lanes: &mut [T]) {
+    for (lane, out) in lanes.chunks_exact_mut(rows.len()).enumerate() {
         for (value, row) in out.iter_mut().zip(rows).skip(done) {
             *value = row[lane];
         }

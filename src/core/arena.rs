@@ -150,6 +150,12 @@ impl<T> Arena<T> {
         self.slots.get_mut(index)?.value.as_mut()
     }
 
+    /// The live values at two different indices, both mutable.
+    pub fn pair_at_mut(&mut self, first: usize, second: usize) -> Option<(&mut T, &mut T)> {
+        let [a, b] = self.slots.get_disjoint_mut([first, second]).ok()?;
+        Some((a.value.as_mut()?, b.value.as_mut()?))
+    }
+
     pub fn id_at(&self, index: usize) -> Option<Id<T>> {
         self.at(index)?;
         Some(self.id_of(index))

@@ -336,8 +336,34 @@ impl Chain {
     /// Re-blends the rest shape for view direction `view` when it or the shapes changed. A changed rest
     /// shape is flagged so the next substep can suppress the momentum it would inject.
     pub(crate) fn update_rest(&mut self, view: Option<Vec3>) {
+        if self.blend_rest(view) {
+            self.update_rest_after_blend();
+        }
+    }
+
+    /// [`update_rest`](Self::update_rest) of two chains, their decodes side by side
+    /// ([`EncodedShape::decode_pair_into`]): the same results as one after the other, sooner.
+    pub(crate) fn update_rest_pair(first: &mut Chain, second: &mut Chain, view: Option<Vec3>) {
+        match (first.blend_rest(view), second.blend_rest(view)) {
+            (true, true) => {
+                EncodedShape::decode_pair_into(
+                    (&first.blended, &first.frame, &mut first.rest.positions),
+                    (&second.blended, &second.frame, &mut second.rest.positions),
+                );
+                first.orient_rest();
+                second.orient_rest();
+            }
+            (true, false) => first.update_rest_after_blend(),
+            (false, true) => second.update_rest_after_blend(),
+            (false, false) => {}
+        }
+    }
+
+    /// The first part of [`update_rest`](Self::update_rest): the blend of the view shapes for `view`, if the
+    /// rest shape is due for an update (returned).
+    fn blend_rest(&mut self, view: Option<Vec3>) -> bool {
         if !self.rest_update_due(view) {
-            return;
+            return false;
         }
         self.shapes_dirty = false;
         self.blended_for = view;
@@ -354,10 +380,18 @@ impl Chain {
             let views = self.views.iter().zip(self.weights.iter()).map(|(v, w)| (&v.encoded, *w));
             blend_into(&self.base, w0, views, &mut self.blended);
         }
+        true
+    }
+
+    fn update_rest_after_blend(&mut self) {
+        self.blended.decode_into(&self.frame, &mut self.rest.positions);
+        self.orient_rest();
+    }
+
+    /// The last part of [`update_rest`](Self::update_rest), after the decode of the blend into the rest
+    /// positions: the rest orientations (each joint's bone swung onto its segment), and the change flagged.
+    fn orient_rest(&mut self) {
         let n = self.joint_count();
-        let mut positions = std::mem::take(&mut self.rest.positions);
-        self.blended.decode_into(&self.frame, &mut positions);
-        self.rest.positions = positions;
         for j in 0..n {
             let q = self.blended.orientations[j];
             self.rest.orientations[j] =
@@ -373,7 +407,7 @@ impl Chain {
     }
 
     /// Whether [`update_rest`](Self::update_rest) for view direction `view` has anything to do.
-    fn rest_update_due(&self, view: Option<Vec3>) -> bool {
+    pub(crate) fn rest_update_due(&self, view: Option<Vec3>) -> bool {
         let view_moved = || match (view, self.blended_for) {
             (Some(v), Some(b)) => (v - b).length() > VIEW_EPSILON,
             (a, b) => a.is_some() != b.is_some(),
@@ -585,6 +619,50 @@ mod tests {
     use glam::{Quat, Vec3};
 
     use super::*;
+
+    #[test]
+    fn a_pair_updates_its_rest_shapes_as_each_alone() {
+        // Chains of 5 and 9 joints hanging down, each with a view shape from +X that leans it sideways.
+        let chain = |joints: usize, lean: f32| {
+            let at = |i: usize, x: f32| Transform::new(Vec3::new(x * i as f32, -0.1 * i as f32, 0.0), Quat::IDENTITY);
+            let straight: Vec<Transform> = (0..joints).map(|i| at(i, 0.0)).collect();
+            let leaning: Vec<Transform> = (0..joints).map(|i| at(i, lean)).collect();
+            let mut chain = Chain::new(ChainParams::default(), &straight).unwrap();
+            let encoded = chain.encode_view_shape(&leaning).unwrap();
+            let weighting = ViewWeighting { direction: Vec3::X, influence: 2.0 };
+            chain.push_view(ViewShape { id: ViewShapeId::from_bits(1), weighting, encoded });
+            chain
+        };
+        let bits = |c: &Chain| {
+            let positions = c.rest.positions.iter().flat_map(|p| p.to_array());
+            let orientations = c.rest.orientations.iter().flat_map(|q| q.to_array());
+            (positions.chain(orientations).map(f32::to_bits).collect::<Vec<_>>(), c.rest_changed)
+        };
+        let view = Some(Vec3::new(0.6, 0.0, 0.8));
+        // Each chain due or not (already blended for this view), in every combination the engine meets.
+        for (first_due, second_due) in [(true, true), (true, false), (false, true)] {
+            let (mut first, mut second) = (chain(5, 0.03), chain(9, -0.05));
+            for (chain, due) in [(&mut first, first_due), (&mut second, second_due)] {
+                if !due {
+                    chain.update_rest(view);
+                    chain.rest_changed = false;
+                }
+            }
+            let (mut first_alone, mut second_alone) = (chain(5, 0.03), chain(9, -0.05));
+            for (chain, due) in [(&mut first_alone, first_due), (&mut second_alone, second_due)] {
+                if !due {
+                    chain.update_rest(view);
+                    chain.rest_changed = false;
+                }
+                chain.update_rest(view);
+            }
+            Chain::update_rest_pair(&mut first, &mut second, view);
+            assert!(first.rest_changed == first_due && second.rest_changed == second_due);
+            assert_eq!(bits(&first), bits(&first_alone));
+            assert_eq!(bits(&second), bits(&second_alone));
+            assert!(!first.rest_update_due(view) && !second.rest_update_due(view));
+        }
+    }
 
     #[test]
     fn cached_constants_follow_every_input() {

@@ -695,6 +695,16 @@ impl Engine {
         self.order.iter().take(READ_AHEAD).for_each(|slot| rest_update_ahead(&self.chains, Some(slot)));
         for (index, &slot) in self.order.iter().enumerate() {
             rest_update_ahead(&self.chains, self.order.get(index + READ_AHEAD));
+            // A chain whose rest shape is due for an update takes the next chain's along
+            // (`Chain::update_rest_pair`), whose own `update_rest` below then has nothing to do.
+            if let Some(&next) = self.order.get(index + 1)
+                && let Some((chain, next)) = self.chains.pair_at_mut(slot as usize, next as usize)
+                && chain.enabled
+                && next.enabled
+                && chain.rest_update_due(self.view)
+            {
+                Chain::update_rest_pair(chain, next, self.view);
+            }
             let chain = self.chains.at_mut(slot as usize).expect("live");
             let mut rebase = rebase;
             let mut rebase_now = |chain: &mut Chain| {

@@ -102,7 +102,7 @@ pub fn shortest_arc(from: Vec3, to: Vec3) -> Quat {
 
 /// Rotates `q` by the smallest swing that makes its local `axis` point along `direction` (unit), keeping
 /// the twist about that axis. This is what makes an output rotation skinning-ready.
-#[inline]
+#[inline(always)]
 pub fn swing_to(q: Quat, axis: Vec3, direction: Vec3) -> Quat {
     let current = q * axis;
     let cos = current.dot(direction);

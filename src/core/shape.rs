@@ -143,14 +143,31 @@ impl EncodedShape {
 
     /// Forward kinematics: root, then rotate the running direction by each `r_j` and step `l_j`.
     pub fn decode_into(&self, frame: &ShapeFrame, positions: &mut [Vec3]) {
-        let mut running = frame.reference;
-        let mut p = frame.root;
-        positions[0] = p;
+        let mut walk = Walk::new(frame, positions);
         for (j, bend) in self.bends.iter().enumerate() {
-            // Renormalising bounds the drift of long chains to one rounding per joint.
-            running = (*bend * running).normalize();
-            p += running * frame.lengths[j];
-            positions[j + 1] = p;
+            walk.step(bend, frame, positions, j);
+        }
+    }
+
+    /// Two shapes' [`decode_into`](Self::decode_into), joint by joint side by side: each decode is a chain of
+    /// dependent steps (a rotation and a normalisation per joint) that alone leaves the core waiting on their
+    /// latency; two independent chains overlap. Each shape's arithmetic is its own decode's: the same bits.
+    pub fn decode_pair_into(
+        (first, first_frame, first_positions): (&Self, &ShapeFrame, &mut [Vec3]),
+        (second, second_frame, second_positions): (&Self, &ShapeFrame, &mut [Vec3]),
+    ) {
+        let mut first_walk = Walk::new(first_frame, first_positions);
+        let mut second_walk = Walk::new(second_frame, second_positions);
+        let both = first.bends.len().min(second.bends.len());
+        for j in 0..both {
+            first_walk.step(&first.bends[j], first_frame, first_positions, j);
+            second_walk.step(&second.bends[j], second_frame, second_positions, j);
+        }
+        for (j, bend) in first.bends.iter().enumerate().skip(both) {
+            first_walk.step(bend, first_frame, first_positions, j);
+        }
+        for (j, bend) in second.bends.iter().enumerate().skip(both) {
+            second_walk.step(bend, second_frame, second_positions, j);
         }
     }
 
@@ -164,6 +181,30 @@ impl EncodedShape {
     pub fn rebase_reference(&mut self, old_reference: Vec3, new_reference: Vec3) {
         let first = (self.bends[0] * old_reference).normalize();
         self.bends[0] = shortest_arc(new_reference, first);
+    }
+}
+
+/// Where forward kinematics has got to: the running direction and the last joint placed.
+struct Walk {
+    running: Vec3,
+    p: Vec3,
+}
+
+impl Walk {
+    /// At the root, which it places.
+    #[inline(always)]
+    fn new(frame: &ShapeFrame, positions: &mut [Vec3]) -> Self {
+        positions[0] = frame.root;
+        Self { running: frame.reference, p: frame.root }
+    }
+
+    /// Turns by bend `j` and places joint `j + 1`.
+    #[inline(always)]
+    fn step(&mut self, bend: &Quat, frame: &ShapeFrame, positions: &mut [Vec3], j: usize) {
+        // Renormalising bounds the drift of long chains to one rounding per joint.
+        self.running = (*bend * self.running).normalize();
+        self.p += self.running * frame.lengths[j];
+        positions[j + 1] = self.p;
     }
 }
 
@@ -239,6 +280,22 @@ mod tests {
                 prop_assert!((*a - *b).length() <= tolerance, "{a} vs {b}");
             }
             prop_assert_eq!(back.orientations, shape.orientations);
+        }
+
+        /// Two shapes decoded side by side, of any lengths, give each the bits of its own decode.
+        #[test]
+        fn a_pair_decodes_as_each_alone(first in arb_chain(), second in arb_chain()) {
+            let encoded = |joints: &[Transform]| {
+                let shape = Shape::from_joints(joints).unwrap();
+                let frame = ShapeFrame::from_base(&shape);
+                (EncodedShape::encode(&shape, frame.reference), frame)
+            };
+            let ((a, a_frame), (b, b_frame)) = (encoded(&first), encoded(&second));
+            let (mut a_pair, mut b_pair) = (vec![Vec3::NAN; first.len()], vec![Vec3::NAN; second.len()]);
+            EncodedShape::decode_pair_into((&a, &a_frame, &mut a_pair), (&b, &b_frame, &mut b_pair));
+            let bits = |positions: &[Vec3]| positions.iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+            prop_assert_eq!(bits(&a_pair), bits(&a.decode(&a_frame).positions));
+            prop_assert_eq!(bits(&b_pair), bits(&b.decode(&b_frame).positions));
         }
     }
 }

@@ -33,6 +33,7 @@ mod lengths;
 mod matching;
 mod output;
 mod polar;
+mod prefetch;
 mod rotations;
 mod scalar;
 mod simd;
@@ -239,12 +240,16 @@ impl LaneSolver {
             for (count, width) in group_widths(same, sixteen) {
                 let (group, remaining) = run.split_at(count);
                 run = remaining;
+                // The next group: the first of the rest of this run, or of the next run (at most `width` chains;
+                // a smaller next group's neighbours come along).
+                let ahead = if run.is_empty() { rest } else { run };
+                let next = &ahead[..ahead.len().min(width)];
                 let (group_fallbacks, group_pairs) = match (width, portable) {
-                    (16, _) => run_group(&mut self.g16, chains, group, clock, reach, &WIDE16),
-                    (8, false) => run_group(&mut self.g8, chains, group, clock, reach, &WIDE8),
-                    (8, true) => run_group(&mut self.g8, chains, group, clock, reach, &Phases::PORTABLE),
-                    (_, false) => run_group(&mut self.g4, chains, group, clock, reach, &WIDE4),
-                    (_, true) => run_group(&mut self.g4, chains, group, clock, reach, &Phases::PORTABLE),
+                    (16, _) => run_group(&mut self.g16, chains, group, next, clock, reach, &WIDE16),
+                    (8, false) => run_group(&mut self.g8, chains, group, next, clock, reach, &WIDE8),
+                    (8, true) => run_group(&mut self.g8, chains, group, next, clock, reach, &Phases::PORTABLE),
+                    (_, false) => run_group(&mut self.g4, chains, group, next, clock, reach, &WIDE4),
+                    (_, true) => run_group(&mut self.g4, chains, group, next, clock, reach, &Phases::PORTABLE),
                 };
                 fallbacks += group_fallbacks;
                 pairs += group_pairs;
@@ -431,12 +436,14 @@ wide_phases!(
     output4
 );
 
-/// Steps the chains of `jobs` (at most `L`) in `g`. Spare lanes repeat the first chain without its contacts;
-/// they are computed like any lane (lanes never affect each other) but not stored or counted.
+/// Steps the chains of `jobs` (at most `L`) in `g`, and asks for those of `next` ([`prefetch`]). Spare lanes
+/// repeat the first chain without its contacts; they are computed like any lane (lanes never affect each
+/// other) but not stored or counted.
 fn run_group<const L: usize>(
     g: &mut LaneGroup<L>,
     chains: &mut Arena<Chain>,
     jobs: &[LaneJob],
+    next: &[LaneJob],
     clock: &Clock<'_>,
     reach: &Reach<'_>,
     phases: &Phases<L>,
@@ -489,6 +496,7 @@ fn run_group<const L: usize>(
         );
     }
     let touching = g.contact_lanes.any();
+    prefetch::chains_of(chains, next);
     let (mut fallbacks, mut pairs) = (0, 0);
     for s in 0..substeps {
         let fell_back = if touching {

@@ -5,6 +5,7 @@ use glam::{Quat, Vec3};
 
 use super::arena::Id;
 use super::blend::blend_into;
+use super::bones::swing_onto_segments;
 use super::buffers::reserve_total;
 use super::error::{Error, Result};
 use super::math::{Transform, direction, nlerp_shorter, swing_to};
@@ -391,15 +392,8 @@ impl Chain {
     /// The last part of [`update_rest`](Self::update_rest), after the decode of the blend into the rest
     /// positions: the rest orientations (each joint's bone swung onto its segment), and the change flagged.
     fn orient_rest(&mut self) {
-        let n = self.joint_count();
-        for j in 0..n {
-            let q = self.blended.orientations[j];
-            self.rest.orientations[j] =
-                match (j + 1 < n).then(|| direction(self.rest.positions[j + 1] - self.rest.positions[j])) {
-                    Some(Some(dir)) => swing_to(q, self.bone_axes[j], dir),
-                    _ => q,
-                };
-        }
+        let rest = &mut self.rest;
+        swing_onto_segments(&self.blended.orientations, &self.bone_axes, &rest.positions, &mut rest.orientations);
         self.rest_groups_stale = true;
         if self.rest != self.rest_used {
             self.rest_changed = true;

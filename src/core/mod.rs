@@ -18,6 +18,7 @@ pub(crate) mod arcs;
 pub mod arena;
 pub mod batch;
 pub mod blend;
+pub(crate) mod bones;
 pub(crate) mod buffers;
 pub mod chain;
 pub mod collider;

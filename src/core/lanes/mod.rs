@@ -35,7 +35,7 @@ mod output;
 mod polar;
 mod prefetch;
 mod rotations;
-mod scalar;
+pub(crate) mod scalar;
 mod simd;
 mod transpose;
 

@@ -127,10 +127,21 @@ fn solve_direct(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> 
 }
 
 /// [`solve_direct`] from the multipliers `history` extrapolates ([`super::warm_start`]), or from none if it
-/// remembers none; `history` learns how it ended.
+/// remembers none; `history` learns how it ended. While the same solve of the last substeps kept ending in
+/// the Gauss-Newton projection, this one goes straight to it, except every [`RETRY_DIRECT`]-th substep: the
+/// direct solve fails on such chains after two to four passes (on the report's 1 x 1000 hair ropes, 1 510 of
+/// 2 372 solves, some twice: warm, then cold), and a failed direct solve leaves `p` as it was, so the
+/// projection computes what it would have computed after it, to the bit.
 fn solve_warm(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, history: &mut MultiplierHistory) -> Solved {
     let m = lengths.len();
     debug_assert!(p.len() == m + 1 && s.start_bonds.len() >= m);
+    if relinearizes(history.relinearized) {
+        // No direct solve's multipliers: the exact projection, if the Gauss-Newton one fails, starts from none.
+        s.newton.mu[..m].fill(0.0);
+        let solved = fall_back(p, lengths, s);
+        history.relinearized = relinearized_after(history.relinearized, solved);
+        return solved;
+    }
     let start = if history.remembered() {
         history.write_start(&mut s.newton.mu[..m]);
         Start::Warm
@@ -148,7 +159,26 @@ fn solve_warm(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, histo
     } else {
         history.forget();
     }
+    history.relinearized = relinearized_after(history.relinearized, solved);
     solved
+}
+
+/// Whether a solve that ended in the Gauss-Newton projection in the last `streak` substeps in a row goes
+/// straight to it ([`solve_warm`]; the lane solver decides the same per lane).
+#[inline(always)]
+pub(crate) fn relinearizes(streak: u32) -> bool {
+    streak >= RELINEARIZE_AFTER && !streak.is_multiple_of(RETRY_DIRECT)
+}
+
+/// The Gauss-Newton projections in a row after which a solve goes straight to it: one alone is most often
+/// a jolt (a collider's push, a fast turn of the root) on a chain whose direct solve works again in the next
+/// substep, and a lane that skips it runs the projection on its own while its group's direct solve runs anyway.
+const RELINEARIZE_AFTER: u32 = 4;
+
+/// A solve's streak of Gauss-Newton projections after it ended in `solved`.
+#[inline(always)]
+pub(crate) fn relinearized_after(streak: u32, solved: Solved) -> u32 {
+    if solved == Solved::GaussNewton { streak + 1 } else { 0 }
 }
 
 /// [`solve_prepared`] for the solve after iteration `iteration` (from 1) of a substep's shape matching: from
@@ -238,8 +268,9 @@ pub struct SolveMemory {
     learnt_at: (u32, u32),
 }
 
-/// A chain whose first solves keep taking the exact projection tries the direct solve again every this many
-/// substeps (every 33 ms at the default 240 Hz), so that it goes back to it soon after it works again.
+/// A chain whose first solves keep taking the exact projection, or a solve that keeps ending in the
+/// Gauss-Newton projection, tries the direct solve again every this many substeps (every 33 ms at the default
+/// 240 Hz), so that it goes back to it soon after it works again.
 const RETRY_DIRECT: u32 = 8;
 
 impl SolveMemory {
@@ -256,7 +287,7 @@ impl SolveMemory {
     /// Forgets what was learnt (the chain was placed anew).
     pub fn forget(&mut self) {
         self.exact_streak = 0;
-        self.warm.iter_mut().for_each(MultiplierHistory::forget);
+        self.warm.iter_mut().for_each(MultiplierHistory::forget_all);
     }
 
     /// Before a substep of length `h` with `iterations` solves (one per iteration): the multipliers learnt
@@ -264,7 +295,7 @@ impl SolveMemory {
     /// does not run.
     pub fn begin_substep(&mut self, h: f32, iterations: u32) {
         if !self.warm_applies(h, iterations) {
-            self.warm.iter_mut().for_each(MultiplierHistory::forget);
+            self.warm.iter_mut().for_each(MultiplierHistory::forget_all);
             self.set_learnt_at(h, iterations);
         }
     }
@@ -306,7 +337,7 @@ impl SolveMemory {
 /// [`RETRY_DIRECT`]-th substep. Returns `false` when the direct solve was not used.
 pub fn solve_first(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, memory: &mut SolveMemory) -> bool {
     if exact_from_memory(p, lengths, s, memory) {
-        memory.warm[0].forget();
+        memory.warm[0].forget_all();
         return false;
     }
     let solved = if memory.warm[0].last.len() == lengths.len() {
@@ -479,8 +510,15 @@ fn project_relinearized(
         if !back_substitute(c_prime, d_prime, mu, step) {
             return false;
         }
+        // As in the direct solve: a step predicted to land within the tolerance ends the projection, without
+        // the pass that would confirm it on these same positions (along the current bonds, `error_after_step`
+        // is exact here too).
+        let landed = pass.worst <= LANDING_GATE && error_after_step(d, mobility, mu, inv_l2) <= TOLERANCE;
         for j in 1..=m {
             p[j] += shift(d, mobility, mu, j);
+        }
+        if landed {
+            return true;
         }
     }
     false
@@ -997,6 +1035,60 @@ mod tests {
             unturned_steps.is_none_or(|steps| steps > shifted_steps),
             "the turn must matter for this test to mean anything"
         );
+    }
+
+    /// A hair rope of 2.5 cm segments, straight at the substep's start and predicted bent through a quarter
+    /// turn and stretched: too far turned for corrections along the start bonds (the direct solve), not for
+    /// the Gauss-Newton projection. Start, lengths, prediction.
+    fn turned_hair() -> (Vec<DVec3>, Vec<f32>, Vec<DVec3>) {
+        let n = 40;
+        let x = line(n, 0.025);
+        let lengths = vec![0.025; n - 1];
+        let p: Vec<DVec3> = (0..n)
+            .map(|i| {
+                let angle = std::f64::consts::FRAC_PI_2 * i as f64 / (n - 1) as f64;
+                let radius = 1.02 * 0.025 * (n - 1) as f64 / std::f64::consts::FRAC_PI_2;
+                DVec3::new(radius * angle.sin(), radius * (angle.cos() - 1.0), 0.001 * (i % 3) as f64)
+            })
+            .collect();
+        (x, lengths, p)
+    }
+
+    /// A solve that ended in the Gauss-Newton projection `RELINEARIZE_AFTER` times in a row goes straight to
+    /// it in the next substeps (the direct solve does not run: its scratch positions stay as they were), with
+    /// the same answer to the bit, because a failed direct solve leaves the positions untouched; every
+    /// `RETRY_DIRECT`-th substep it tries the direct solve again, and a solve that ends in the direct solve
+    /// ends the streak.
+    #[test]
+    fn a_solve_that_keeps_falling_back_goes_straight_to_gauss_newton() {
+        let (x, lengths, p) = turned_hair();
+        let m = lengths.len();
+        let mut s = ConstraintScratch::default();
+        prepare(&x, &lengths, &mut s);
+        let mut history = MultiplierHistory::new(m);
+        let mut first = p.clone();
+        assert_eq!(solve_warm(&mut first, &lengths, &mut s, &mut history), Solved::GaussNewton);
+        assert!(max_stretch(&first, &lengths) < 1e-6, "{}", max_stretch(&first, &lengths));
+        assert_eq!(history.relinearized, 1);
+        for streak in 1..=RETRY_DIRECT {
+            s.newton.corrected.fill(DVec3::NAN);
+            let mut again = p.clone();
+            assert_eq!(solve_warm(&mut again, &lengths, &mut s, &mut history), Solved::GaussNewton);
+            assert!(crate::core::rod::same_bits(&again, &first), "streak {streak}");
+            assert_eq!(history.relinearized, streak + 1);
+            let direct_ran = !s.newton.corrected[1].is_nan();
+            assert_eq!(direct_ran, streak < RELINEARIZE_AFTER || streak == RETRY_DIRECT, "streak {streak}");
+        }
+        // A prediction the direct solve meets, at a retry: the streak ends.
+        history.relinearized = 2 * RETRY_DIRECT;
+        let mut easy: Vec<DVec3> = x.iter().map(|v| *v - DVec3::Y * 1.7e-4 * (v.x / 0.025)).collect();
+        assert_eq!(solve_warm(&mut easy, &lengths, &mut s, &mut history), Solved::Direct);
+        assert_eq!(history.relinearized, 0);
+        // And forgetting the chain's memory (placed anew) ends one too.
+        let mut memory = SolveMemory::new(m);
+        memory.warm[1].relinearized = 3;
+        memory.forget();
+        assert_eq!(memory.warm[1].relinearized, 0);
     }
 
     #[test]

@@ -17,6 +17,9 @@
 //! again from none, with what a cold start computes, to the bit: a history that no longer fits (a collider's
 //! push, a teleport, a chain woken from sleep) costs one pass, not a solve from far off. A solve that ends in
 //! a fallback forgets its history, and so does a change of substep length or iteration count.
+//!
+//! A solve also counts the substeps in a row it ended in the Gauss-Newton projection
+//! (`MultiplierHistory::relinearized`): while that streak runs, `inextensible` goes straight to that projection.
 
 /// The solves of a substep that start from their history: the first after the prediction and the one after
 /// the second shape-matching pass. Later ones (more than two iterations) start from none.
@@ -30,19 +33,30 @@ pub struct MultiplierHistory {
     pub(crate) before: Vec<f64>,
     /// Whether `last` and `before` hold multipliers (a solve that fell back, or none yet, leaves none).
     pub(crate) remembered: bool,
+    /// Substeps in a row this solve ended in the Gauss-Newton projection (`inextensible`'s fallback after a
+    /// direct solve that fails: hair-length segments of long chains, which turn too far in a substep for the
+    /// start directions).
+    pub(crate) relinearized: u32,
 }
 
 impl MultiplierHistory {
     pub fn new(bonds: usize) -> Self {
-        Self { last: vec![0.0; bonds], before: vec![0.0; bonds], remembered: false }
+        Self { last: vec![0.0; bonds], before: vec![0.0; bonds], remembered: false, relinearized: 0 }
     }
 
     pub fn remembered(&self) -> bool {
         self.remembered
     }
 
+    /// Forgets the multipliers (the streak of Gauss-Newton projections stays).
     pub fn forget(&mut self) {
         self.remembered = false;
+    }
+
+    /// Forgets the multipliers and the streak.
+    pub fn forget_all(&mut self) {
+        self.remembered = false;
+        self.relinearized = 0;
     }
 
     /// The start of bond `k`'s multiplier: the last two's line extended by a substep (`2 last - before`;
@@ -74,11 +88,12 @@ impl MultiplierHistory {
         self.remembered = true;
     }
 
-    /// Words for the engine's state hash (the multipliers only while they are used).
+    /// Words for the engine's state hash (the multipliers only while they are used; the streak shares the
+    /// flag's word, so that a state without one hashes as before the streak was kept).
     pub(crate) fn words(&self) -> impl Iterator<Item = u64> + '_ {
         let used = if self.remembered { self.last.len() } else { 0 };
         let values = self.last[..used].iter().chain(&self.before[..used]).map(|v| v.to_bits());
-        std::iter::once(self.remembered as u64).chain(values)
+        std::iter::once(self.remembered as u64 | (self.relinearized as u64) << 1).chain(values)
     }
 }
 

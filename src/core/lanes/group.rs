@@ -116,11 +116,18 @@ pub struct LaneGroup<const L: usize> {
 }
 
 /// `MultiplierHistory` on every lane.
-#[derive(Default)]
 pub struct WarmLanes<const L: usize> {
     pub(super) last: Vec<D<L>>,
     pub(super) before: Vec<D<L>>,
     pub(super) remembered: Mask<L>,
+    /// `MultiplierHistory::relinearized`: each lane's streak of Gauss-Newton projections.
+    pub(super) relinearized: [u32; L],
+}
+
+impl<const L: usize> Default for WarmLanes<L> {
+    fn default() -> Self {
+        Self { last: Vec::new(), before: Vec::new(), remembered: Mask::default(), relinearized: [0; L] }
+    }
 }
 
 impl<const L: usize> Default for V3<L> {
@@ -318,6 +325,10 @@ impl<const L: usize> LaneGroup<L> {
                 applies[lane] && history(lane).remembered() && history(lane).last.len() == bonds
             });
             warm.remembered = Mask(remembered);
+            // As `SolveMemory::begin_substep`: another rate or iteration count ends the streak too.
+            warm.relinearized = std::array::from_fn(|lane| {
+                if applies[lane] && history(lane).last.len() == bonds { history(lane).relinearized } else { 0 }
+            });
             if !warm.remembered.any() {
                 continue;
             }
@@ -446,6 +457,9 @@ impl<const L: usize> LaneGroup<L> {
         let rows = &self.lanes64[3 * n * L..];
         let row = |region: usize| &rows[(region * L + lane) * bonds..][..bonds];
         for (slot, (warm, history)) in self.warm.iter().zip(&mut memory.warm).enumerate() {
+            if history.last.len() == bonds {
+                history.relinearized = warm.relinearized[lane];
+            }
             if warm.remembered.0[lane] && history.last.len() == bonds {
                 history.last.copy_from_slice(row(2 * slot));
                 history.before.copy_from_slice(row(2 * slot + 1));

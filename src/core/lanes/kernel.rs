@@ -87,7 +87,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
                     let failed = vector.and(solved.not());
                     if failed.any() {
                         fell_back = fell_back.or(failed);
-                        fall_back(g, failed, false);
+                        fall_back(g, failed, Mask([false; L]), false);
                     }
                 }
                 if sliding.any() {
@@ -145,21 +145,37 @@ pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, predict: Pr
 /// solves have been taking the exact projection start with it, from their remembered tensions.
 fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>, iteration: usize) -> Mask<L> {
     let first = iteration == 0;
+    let slot = (iteration < WARM_SLOTS).then_some(iteration);
     if g.shape_matching {
         (phases.match_shape)(g, landing_angle(iteration as u32, iterations(g)));
     }
     // Most groups have no lane that remembers anything.
     let remembering = first && g.memories.iter().any(SolveMemory::in_streak);
-    let direct = if remembering { exact_from_memory(g) } else { Mask([true; L]) };
-    let solved = (phases.solve_lengths)(g, direct, (iteration < WARM_SLOTS).then_some(iteration));
+    let pending = if remembering { exact_from_memory(g) } else { Mask([true; L]) };
+    // Lanes whose solve keeps ending in the Gauss-Newton projection go straight to it (`inextensible::solve_warm`).
+    // Most groups have no lane in such a streak.
+    let streaking = slot.filter(|&slot| g.warm[slot].relinearized != [0; L]);
+    let relinearizing = match streaking {
+        Some(slot) => Mask(g.warm[slot].relinearized.map(inextensible::relinearizes)).and(pending),
+        None => Mask([false; L]),
+    };
+    let direct = pending.and(relinearizing.not());
+    let solved = (phases.solve_lengths)(g, direct, slot);
     if remembering {
         for lane in (0..L).filter(|&lane| solved.0[lane]) {
             g.memories[lane].learn(Solved::Direct, &g.constraints, g.n - 1);
         }
     }
     let failed = direct.and(solved.not());
-    if failed.any() {
-        fall_back(g, failed, first);
+    let falling_back = failed.or(relinearizing).any();
+    let ended = if falling_back { fall_back(g, failed, relinearizing, first) } else { [None; L] };
+    if let Some(slot) = slot.filter(|_| falling_back || streaking.is_some()) {
+        // Every lane's streak as `inextensible::relinearized_after` leaves it; a lane that did not fall back
+        // ended in the direct solve or the exact projection from memory (`solve_first`), which ends it.
+        let streaks = &mut g.warm[slot].relinearized;
+        for (streak, ended) in streaks.iter_mut().zip(ended) {
+            *streak = ended.map_or(0, |solved| inextensible::relinearized_after(*streak, solved));
+        }
     }
     solved.not()
 }
@@ -325,24 +341,37 @@ fn pull_to_goal<const L: usize>(p: DV3<L>, centre: DV3<L>, offset: V3<L>, alpha:
     p + (goal - p).scale(alpha)
 }
 
-/// The scalar fallback for every lane in `failed`, one lane at a time; a substep's first solve (`learn`)
-/// also updates the lane's solve memory.
+/// The scalar fallback for every lane in `failed` (from its direct solve's last multipliers) and in
+/// `relinearizing` (from none: it skipped the direct solve), one lane at a time; a substep's first solve
+/// (`learn`) also updates the lane's solve memory. Returns how each of those lanes' solve ended.
 #[cold]
-fn fall_back<const L: usize>(g: &mut LaneGroup<L>, failed: Mask<L>, learn: bool) {
+fn fall_back<const L: usize>(
+    g: &mut LaneGroup<L>,
+    failed: Mask<L>,
+    relinearizing: Mask<L>,
+    learn: bool,
+) -> [Option<Solved>; L] {
     let n = g.n;
+    let mut ended = [None; L];
     for lane in 0..L {
-        if !failed.0[lane] {
+        if !(failed.0[lane] || relinearizing.0[lane]) {
             continue;
         }
         contacts::extract(&g.p[..n], lane, &mut g.lane_p);
         g.lane_lengths.clear();
         g.lane_lengths.extend(g.lengths[..n - 1].iter().map(|l| l.0[lane]));
         g.lane_mu.clear();
-        g.lane_mu.extend(g.mu[..n - 1].iter().map(|mu| mu.0[lane]));
+        if relinearizing.0[lane] {
+            g.lane_mu.resize(n - 1, 0.0);
+        } else {
+            g.lane_mu.extend(g.mu[..n - 1].iter().map(|mu| mu.0[lane]));
+        }
         let solved = inextensible::solve_fallback(&mut g.lane_p, &g.lane_lengths, &g.lane_mu, &mut g.constraints);
         if learn {
             g.memories[lane].learn(solved, &g.constraints, n - 1);
         }
         contacts::write_back(&g.lane_p, lane, &mut g.p[..n]);
+        ended[lane] = Some(solved);
     }
+    ended
 }

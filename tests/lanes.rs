@@ -390,6 +390,27 @@ fn fine_ropes_on_a_collider_match_the_scalar_solver() {
     );
 }
 
+/// Four limp chains (no shape matching) on the lane solver and the same on the scalar solver, driven for
+/// `frames`: every frame, all four in one lane group, the same contact pairs and fallbacks, the same bits.
+fn drive_limp_side_by_side(
+    lanes: &mut Engine,
+    ids: &[ChainId],
+    scalar: &mut Engine,
+    scalar_ids: &[ChainId],
+    frames: usize,
+) {
+    for frame in 0..frames {
+        drive(lanes, frame..frame + 1);
+        drive(scalar, frame..frame + 1);
+        assert_eq!(lanes.stats().lane_chains, 4);
+        assert_eq!(lanes.stats().contact_pairs_tested, scalar.stats().contact_pairs_tested, "frame {frame}");
+        assert_eq!(lanes.stats().solver_fallbacks, scalar.stats().solver_fallbacks, "frame {frame}");
+        for (&id, &scalar_id) in ids.iter().zip(scalar_ids) {
+            assert_eq!(particle_bits(lanes, id), particle_bits(scalar, scalar_id), "frame {frame}");
+        }
+    }
+}
+
 /// Bug 9's ropes (docs/robustness.md) side by side: roots inside the head sphere's reach, so the contact
 /// rounds turn the joints the roots hold and let the joint past them slide on the sphere
 /// (`inextensible::solve_sliding`), which the lane solver runs lane by lane with the scalar code. Limp ropes
@@ -415,16 +436,7 @@ fn ropes_rooted_inside_a_collider_match_the_scalar_solver() {
     };
     let (mut lanes, ids) = build_rooted(Solver::Lanes);
     let (mut scalar, scalar_ids) = build_rooted(Solver::Scalar);
-    for frame in 0..30 {
-        drive(&mut lanes, frame..frame + 1);
-        drive(&mut scalar, frame..frame + 1);
-        assert_eq!(lanes.stats().lane_chains, 4);
-        assert_eq!(lanes.stats().contact_pairs_tested, scalar.stats().contact_pairs_tested, "frame {frame}");
-        assert_eq!(lanes.stats().solver_fallbacks, scalar.stats().solver_fallbacks, "frame {frame}");
-        for (&id, &scalar_id) in ids.iter().zip(&scalar_ids) {
-            assert_eq!(particle_bits(&lanes, id), particle_bits(&scalar, scalar_id), "frame {frame}");
-        }
-    }
+    drive_limp_side_by_side(&mut lanes, &ids, &mut scalar, &scalar_ids, 30);
     // The joints past the held ones (2 x 9 mm of rest length from the root) are out of the sphere's reach.
     let head_pose = head(29);
     let deepest = ids
@@ -468,15 +480,7 @@ fn hair_ropes_that_keep_falling_back_match_the_scalar_solver() {
     };
     let (mut lanes, ids) = build_ropes(Solver::Lanes);
     let (mut scalar, scalar_ids) = build_ropes(Solver::Scalar);
-    for frame in 0..30 {
-        drive(&mut lanes, frame..frame + 1);
-        drive(&mut scalar, frame..frame + 1);
-        assert_eq!(lanes.stats().lane_chains, 4);
-        assert_eq!(lanes.stats().solver_fallbacks, scalar.stats().solver_fallbacks, "frame {frame}");
-        for (&id, &scalar_id) in ids.iter().zip(&scalar_ids) {
-            assert_eq!(particle_bits(&lanes, id), particle_bits(&scalar, scalar_id), "frame {frame}");
-        }
-    }
+    drive_limp_side_by_side(&mut lanes, &ids, &mut scalar, &scalar_ids, 30);
     let (fallbacks, chain_substeps) = (lanes.stats().solver_fallbacks, lanes.stats().substeps_total * 4);
     println!(
         "hair ropes, 0.5 s: the same bits on both solvers; fallback in {fallbacks} of {chain_substeps} chain-substeps"

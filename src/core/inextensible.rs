@@ -129,9 +129,9 @@ fn solve_direct(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> 
 /// [`solve_direct`] from the multipliers `history` extrapolates ([`super::warm_start`]), or from none if it
 /// remembers none; `history` learns how it ended. While the same solve of the last substeps kept ending in
 /// the Gauss-Newton projection, this one goes straight to it, except every [`RETRY_DIRECT`]-th substep: the
-/// direct solve fails on such chains after two to four passes (on the report's 1 x 1000 hair ropes, 1 510 of
-/// 2 372 solves, some twice: warm, then cold), and a failed direct solve leaves `p` as it was, so the
-/// projection computes what it would have computed after it, to the bit.
+/// direct solve fails on such chains after two to four passes, some twice (warm, then cold; on the report's
+/// 1 x 1000 hair rope it took 20 % of the samples, `docs/robustness.md` bug 1), and a failed direct solve
+/// leaves `p` as it was, so the projection computes what it would have computed after it, to the bit.
 fn solve_warm(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, history: &mut MultiplierHistory) -> Solved {
     let m = lengths.len();
     debug_assert!(p.len() == m + 1 && s.start_bonds.len() >= m);
@@ -178,7 +178,8 @@ const RELINEARIZE_AFTER: u32 = 4;
 /// A solve's streak of Gauss-Newton projections after it ended in `solved`.
 #[inline(always)]
 pub(crate) fn relinearized_after(streak: u32, solved: Solved) -> u32 {
-    if solved == Solved::GaussNewton { streak + 1 } else { 0 }
+    // Wrapping: a streak of 2^32 substeps (200 days at 240 Hz) starts again from the direct solve, not a panic.
+    if solved == Solved::GaussNewton { streak.wrapping_add(1) } else { 0 }
 }
 
 /// [`solve_prepared`] for the solve after iteration `iteration` (from 1) of a substep's shape matching: from
@@ -513,7 +514,7 @@ fn project_relinearized(
         // As in the direct solve: a step predicted to land within the tolerance ends the projection, without
         // the pass that would confirm it on these same positions (along the current bonds, `error_after_step`
         // is exact here too).
-        let landed = pass.worst <= LANDING_GATE && error_after_step(d, mobility, mu, inv_l2) <= TOLERANCE;
+        let landed = pass.worst <= LANDING_GATE && error_after_step(d, mobility, step, inv_l2) <= TOLERANCE;
         for j in 1..=m {
             p[j] += shift(d, mobility, mu, j);
         }

@@ -457,10 +457,12 @@ impl<const L: usize> LaneGroup<L> {
         let rows = &self.lanes64[3 * n * L..];
         let row = |region: usize| &rows[(region * L + lane) * bonds..][..bonds];
         for (slot, (warm, history)) in self.warm.iter().zip(&mut memory.warm).enumerate() {
-            if history.last.len() == bonds {
-                history.relinearized = warm.relinearized[lane];
+            if history.last.len() != bonds {
+                history.forget();
+                continue;
             }
-            if warm.remembered.0[lane] && history.last.len() == bonds {
+            history.relinearized = warm.relinearized[lane];
+            if warm.remembered.0[lane] {
                 history.last.copy_from_slice(row(2 * slot));
                 history.before.copy_from_slice(row(2 * slot + 1));
                 history.remembered = true;

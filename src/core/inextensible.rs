@@ -57,11 +57,13 @@ struct NewtonScratch {
     corrected: Vec<DVec3>,
     /// The last Newton step of the multipliers.
     step: Vec<f64>,
+    /// The Gauss-Newton projection's rows of the system, before its elimination ([`TwistedPass`]).
+    rows: Vec<BondRow>,
 }
 
 impl ConstraintScratch {
     pub fn reserve(&mut self, bonds: usize) {
-        let NewtonScratch { mu, c_prime, d_prime, corrected, step } = &mut self.newton;
+        let NewtonScratch { mu, c_prime, d_prime, corrected, step, rows } = &mut self.newton;
         for v in [&mut self.length_squared, &mut self.inverse_length_squared, mu, c_prime, d_prime, step] {
             if v.len() < bonds {
                 v.resize(bonds, 0.0);
@@ -71,6 +73,9 @@ impl ConstraintScratch {
             if v.len() < bonds {
                 v.resize(bonds, DVec3::ZERO);
             }
+        }
+        if rows.len() < bonds {
+            rows.resize(bonds, BondRow::default());
         }
         if corrected.len() < bonds + 1 {
             corrected.resize(bonds + 1, DVec3::ZERO);
@@ -484,16 +489,18 @@ fn project_relinearized(
     let p = &mut p[..m + 1];
     let (l2, inv_l2) = (&length_squared[..m], &inverse_length_squared[..m]);
     let (mu, c_prime, d_prime, step) = (&mut s.mu[..m], &mut s.c_prime[..m], &mut s.d_prime[..m], &mut s.step[..m]);
+    let rows = &mut s.rows[..m];
     let mut previous_worst = f64::INFINITY;
     let mut lost = f64::INFINITY;
+    if m == 0 {
+        return true;
+    }
     for iteration in 0..RELINEARIZED_ITERATIONS {
         for k in 0..m {
             d[k] = p[k + 1] - p[k];
         }
-        let mut pass = ForwardPass::default();
-        for k in 0..m {
-            pass.row(k, d[k], d, mobility, l2[k], inv_l2[k], c_prime, d_prime);
-        }
+        let twisted = TwistedPass::run(d, mobility, l2, inv_l2, rows, c_prime, d_prime);
+        let pass = &twisted.summary;
         if pass.converged(previous_worst) {
             return true;
         }
@@ -508,7 +515,7 @@ fn project_relinearized(
         }
         // Each iteration's multipliers are a step of their own, from the bonds as they are now.
         mu.fill(0.0);
-        if !back_substitute(c_prime, d_prime, mu, step) {
+        if !twisted.back_substitute(c_prime, d_prime, mu, step) {
             return false;
         }
         // As in the direct solve: a step predicted to land within the tolerance ends the projection, without
@@ -689,21 +696,41 @@ fn shift(d: &[DVec3], mobility: &impl Mobility, mu: &[f64], j: usize) -> DVec3 {
     mobility.allowed(j, if j < d.len() { pulled - d[j] * mu[j] } else { pulled })
 }
 
+/// Bond `k`'s row of the Newton system: its `F_k` and its entries in `J`.
+#[derive(Clone, Copy, Default)]
+struct BondRow {
+    f: f64,
+    diagonal: f64,
+    /// Towards bond `k - 1` (zero for the first bond) and bond `k + 1` (zero for the last).
+    lower: f64,
+    upper: f64,
+}
+
+impl BondRow {
+    /// Of bond `k` with vector `b`, corrected along the directions `d`.
+    #[inline(always)]
+    fn new(k: usize, b: DVec3, d: &[DVec3], mobility: &impl Mobility, l2: f64) -> Self {
+        let m = d.len();
+        let f = b.length_squared() - l2;
+        // The bond as each of its ends may change it (the mobility is a projection: `b . W d = W b . d`). For
+        // free particles both are `b`, and the diagonal is `2 b . d[k]` to the bit.
+        let (at_start, at_end) = (mobility.allowed(k, b), mobility.allowed(k + 1, b));
+        // The root's end of bond 0 does not move, so bond 0's own correction counts once.
+        let diagonal = if k > 0 { at_end.dot(d[k]) + at_start.dot(d[k]) } else { at_end.dot(d[k]) };
+        let lower = if k > 0 { -at_start.dot(d[k - 1]) } else { 0.0 };
+        let upper = if k + 1 < m { -at_end.dot(d[k + 1]) } else { 0.0 };
+        Self { f, diagonal, lower, upper }
+    }
+}
+
 /// The running state of one root-to-tip pass of [`newton_along_directions`].
+#[derive(Default)]
 struct ForwardPass {
     /// Largest relative error `|F_k| / l_k^2`.
     worst: f64,
-    /// Largest diagonal entry of `J`, and the smallest pivot of the elimination, by magnitude.
+    /// Largest diagonal entry of `J` by magnitude.
     scale: f64,
-    smallest_pivot: f64,
-    c_last: f64,
-    d_last: f64,
-}
-
-impl Default for ForwardPass {
-    fn default() -> Self {
-        Self { worst: 0.0, scale: 0.0, smallest_pivot: f64::INFINITY, c_last: 0.0, d_last: 0.0 }
-    }
+    sweep: Sweep,
 }
 
 impl ForwardPass {
@@ -721,34 +748,23 @@ impl ForwardPass {
         c_prime: &mut [f64],
         d_prime: &mut [f64],
     ) {
-        let m = d.len();
-        let f = b.length_squared() - l2;
-        let error = (f * inv_l2).abs();
+        let row = BondRow::new(k, b, d, mobility, l2);
+        self.take_row(&row, inv_l2);
+        self.sweep.eliminate(&row, row.lower, row.upper);
+        (c_prime[k], d_prime[k]) = (self.sweep.c_last, self.sweep.d_last);
+    }
+
+    /// A row's error and diagonal entry.
+    #[inline(always)]
+    fn take_row(&mut self, row: &BondRow, inv_l2: f64) {
+        let error = (row.f * inv_l2).abs();
         // As `f64::max`: a NaN error is ignored here (and fails the elimination instead).
         if error > self.worst {
             self.worst = error;
         }
-        // The bond as each of its ends may change it (the mobility is a projection: `b . W d = W b . d`). For
-        // free particles both are `b`, and the diagonal is `2 b . d[k]` to the bit.
-        let (at_start, at_end) = (mobility.allowed(k, b), mobility.allowed(k + 1, b));
-        // The root's end of bond 0 does not move, so bond 0's own correction counts once.
-        let diagonal = if k > 0 { at_end.dot(d[k]) + at_start.dot(d[k]) } else { at_end.dot(d[k]) };
-        let lower = if k > 0 { -at_start.dot(d[k - 1]) } else { 0.0 };
-        let upper = if k + 1 < m { -at_end.dot(d[k + 1]) } else { 0.0 };
-        let den = diagonal - lower * self.c_last;
-        if diagonal.abs() > self.scale {
-            self.scale = diagonal.abs();
+        if row.diagonal.abs() > self.scale {
+            self.scale = row.diagonal.abs();
         }
-        // As `f64::min`: a NaN pivot is skipped here but turns every later `d_prime` into NaN, so the back
-        // substitution fails.
-        if den.abs() < self.smallest_pivot {
-            self.smallest_pivot = den.abs();
-        }
-        let inv = 1.0 / den;
-        self.c_last = upper * inv;
-        self.d_last = (-0.5 * f - lower * self.d_last) * inv;
-        c_prime[k] = self.c_last;
-        d_prime[k] = self.d_last;
     }
 
     /// Converged, or at the rounding floor: Newton converges quadratically, so a pass that fails to halve the
@@ -767,7 +783,132 @@ impl ForwardPass {
 
     /// No pivot vanished (relative to the largest diagonal entry); false for NaN too.
     fn pivots_usable(&self) -> bool {
-        self.scale > 0.0 && self.smallest_pivot > self.scale * MIN_PIVOT
+        self.scale > 0.0 && self.sweep.smallest_pivot > self.scale * MIN_PIVOT
+    }
+}
+
+/// The forward elimination of the Thomas algorithm as it goes, one row at a time: the smallest pivot by
+/// magnitude, and the last row's modified entries.
+struct Sweep {
+    smallest_pivot: f64,
+    c_last: f64,
+    d_last: f64,
+}
+
+impl Default for Sweep {
+    fn default() -> Self {
+        Self { smallest_pivot: f64::INFINITY, c_last: 0.0, d_last: 0.0 }
+    }
+}
+
+impl Sweep {
+    /// A row of the sweep (one division): `done` is its entry towards the rows already eliminated, `next`
+    /// towards those still to come.
+    #[inline(always)]
+    fn eliminate(&mut self, row: &BondRow, done: f64, next: f64) {
+        let den = row.diagonal - done * self.c_last;
+        self.take_pivot(den);
+        let inv = 1.0 / den;
+        self.c_last = next * inv;
+        self.d_last = (-0.5 * row.f - done * self.d_last) * inv;
+    }
+
+    #[inline(always)]
+    fn take_pivot(&mut self, pivot: f64) {
+        // As `f64::min`: a NaN pivot is skipped here but turns every later `d_prime` into NaN, so the back
+        // substitution fails.
+        if pivot.abs() < self.smallest_pivot {
+            self.smallest_pivot = pivot.abs();
+        }
+    }
+}
+
+/// One elimination of the Gauss-Newton projection, from both ends of the chain at once (a twisted
+/// factorisation): the bonds below the middle one root to tip, those above it tip to root, a row of each
+/// sweep in turn, and the middle bond's row from both. Each sweep is a chain of dependent divisions; the two
+/// halves overlap, where one sweep over every bond waits on each division in turn (the projection's time on
+/// long chains, whose solves keep ending in it, goes mostly to that wait). The same system and the same
+/// checks as [`ForwardPass`]; other roundings.
+struct TwistedPass {
+    /// Both sweeps' and the middle row's errors, diagonal and pivots, as one pass over every bond has them.
+    summary: ForwardPass,
+    /// The middle bond, and its step.
+    twist: usize,
+    middle: f64,
+}
+
+impl TwistedPass {
+    /// The elimination of the system along the directions `d` at the bonds `d` (at least one), into `c_prime`
+    /// and `d_prime` (the sweep from the root's below the middle bond, the sweep from the tip's above it).
+    /// Every row is set up first (`rows` is scratch), so that the sweeps' loop holds only their chains of
+    /// divisions and the core's window reaches far enough ahead to run both at once.
+    #[inline(always)]
+    fn run(
+        d: &[DVec3],
+        mobility: &impl Mobility,
+        l2: &[f64],
+        inv_l2: &[f64],
+        rows: &mut [BondRow],
+        c_prime: &mut [f64],
+        d_prime: &mut [f64],
+    ) -> Self {
+        let m = d.len();
+        let (rows, c_prime, d_prime) = (&mut rows[..m], &mut c_prime[..m], &mut d_prime[..m]);
+        let mut summary = ForwardPass::default();
+        for (k, row) in rows.iter_mut().enumerate() {
+            *row = BondRow::new(k, d[k], d, mobility, l2[k]);
+            summary.take_row(row, inv_l2[k]);
+        }
+        let twist = m / 2;
+        // Bonds above the middle; there are as many below it, or one more.
+        let paired = m - 1 - twist;
+        let (mut from_root, mut from_tip) = (Sweep::default(), Sweep::default());
+        for below in 0..paired {
+            let above = m - 1 - below;
+            from_root.eliminate(&rows[below], rows[below].lower, rows[below].upper);
+            (c_prime[below], d_prime[below]) = (from_root.c_last, from_root.d_last);
+            from_tip.eliminate(&rows[above], rows[above].upper, rows[above].lower);
+            (c_prime[above], d_prime[above]) = (from_tip.c_last, from_tip.d_last);
+        }
+        if twist > paired {
+            from_root.eliminate(&rows[paired], rows[paired].lower, rows[paired].upper);
+            (c_prime[paired], d_prime[paired]) = (from_root.c_last, from_root.d_last);
+        }
+        let row = &rows[twist];
+        let den = row.diagonal - row.lower * from_root.c_last - row.upper * from_tip.c_last;
+        let middle = (-0.5 * row.f - row.lower * from_root.d_last - row.upper * from_tip.d_last) / den;
+        summary.sweep.take_pivot(from_root.smallest_pivot);
+        summary.sweep.take_pivot(from_tip.smallest_pivot);
+        summary.sweep.take_pivot(den);
+        Self { summary, twist, middle }
+    }
+
+    /// The passes back, from the middle bond to both ends side by side: adds the step to `mu` and stores it
+    /// in `step`. Returns `false` if the step is not finite (as [`back_substitute`]).
+    #[inline(always)]
+    fn back_substitute(&self, c_prime: &[f64], d_prime: &[f64], mu: &mut [f64], step: &mut [f64]) -> bool {
+        let (m, twist) = (mu.len(), self.twist);
+        let paired = m - 1 - twist;
+        step[twist] = self.middle;
+        mu[twist] += self.middle;
+        let (mut toward_root, mut toward_tip) = (self.middle, self.middle);
+        for i in 1..=paired {
+            let below = twist - i;
+            toward_root = d_prime[below] - c_prime[below] * toward_root;
+            step[below] = toward_root;
+            mu[below] += toward_root;
+            let above = twist + i;
+            toward_tip = d_prime[above] - c_prime[above] * toward_tip;
+            step[above] = toward_tip;
+            mu[above] += toward_tip;
+        }
+        if twist > paired {
+            toward_root = d_prime[0] - c_prime[0] * toward_root;
+            step[0] = toward_root;
+            mu[0] += toward_root;
+        }
+        // As in `back_substitute`: a non-finite entry makes every later one of its pass non-finite.
+        toward_root.is_finite() && toward_tip.is_finite()
     }
 }
 
@@ -794,6 +935,55 @@ fn project_gauss_seidel(p: &mut [DVec3], lengths: &[f32]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The Gauss-Newton step of bonds `d` from both ends at once ([`TwistedPass`]) against the one-ended
+    /// Thomas solve of the same rows ([`ForwardPass`], [`back_substitute`]): every chain length from one bond,
+    /// even and odd, free and with sliding particles. The two differ by rounding alone, and the passes' error
+    /// and diagonal checks agree to the bit.
+    #[test]
+    fn the_two_ended_elimination_solves_the_one_ended_system() {
+        for m in (1..=12).chain([63, 64, 1000]) {
+            let d: Vec<DVec3> = (0..m)
+                .map(|k| {
+                    let t = k as f64;
+                    DVec3::new(0.02 * (0.9 * t).cos(), -0.025 + 0.004 * (1.3 * t).sin(), 0.01 * (0.4 * t).sin())
+                })
+                .collect();
+            // Rest lengths 0 % to 10 % shorter than the bonds, so that most rows have an error to correct.
+            let l2: Vec<f64> =
+                d.iter().enumerate().map(|(k, b)| b.length_squared() * (0.9 + 0.02 * (k % 6) as f64)).collect();
+            let normals: Vec<Vec3> =
+                (0..=m).map(|j| if j % 3 == 1 { Vec3::new(0.6, 0.0, 0.8) } else { Vec3::ZERO }).collect();
+            assert_twisted_matches_thomas(&d, &l2, &Free);
+            assert_twisted_matches_thomas(&d, &l2, &Sliding(&normals));
+        }
+    }
+
+    fn assert_twisted_matches_thomas(d: &[DVec3], l2: &[f64], mobility: &impl Mobility) {
+        let m = d.len();
+        let inv_l2: Vec<f64> = l2.iter().map(|l| 1.0 / l).collect();
+        let zeros = || vec![0.0f64; m];
+        let (mut c_prime, mut d_prime, mut mu, mut step) = (zeros(), zeros(), zeros(), zeros());
+        let mut one_ended = ForwardPass::default();
+        for k in 0..m {
+            one_ended.row(k, d[k], d, mobility, l2[k], inv_l2[k], &mut c_prime, &mut d_prime);
+        }
+        assert!(back_substitute(&c_prime, &d_prime, &mut mu, &mut step));
+        let (mut c_twisted, mut d_twisted, mut mu_twisted, mut step_twisted) = (zeros(), zeros(), zeros(), zeros());
+        let mut rows = vec![BondRow::default(); m];
+        let twisted = TwistedPass::run(d, mobility, l2, &inv_l2, &mut rows, &mut c_twisted, &mut d_twisted);
+        assert!(twisted.back_substitute(&c_twisted, &d_twisted, &mut mu_twisted, &mut step_twisted));
+        let largest = step.iter().fold(0.0f64, |a, s| a.max(s.abs()));
+        assert!(largest > 0.0, "m {m}");
+        for k in 0..m {
+            let (one, two) = (step[k], step_twisted[k]);
+            assert!((one - two).abs() <= 1e-9 * largest, "m {m}, bond {k}: {one} vs {two}");
+            assert_eq!(mu_twisted[k], two);
+        }
+        assert_eq!(twisted.summary.worst, one_ended.worst, "m {m}");
+        assert_eq!(twisted.summary.scale, one_ended.scale, "m {m}");
+        assert!(twisted.summary.pivots_usable() && one_ended.pivots_usable(), "m {m}");
+    }
 
     fn max_stretch(p: &[DVec3], lengths: &[f32]) -> f64 {
         lengths

@@ -36,9 +36,10 @@ pub(crate) const LANDING_ANGLE: f32 = 3e-3;
 /// own steps: only the substep's last pass must end at float rounding. With two passes per substep, the first
 /// starts a substep's motion away from the last substep's answer, and its groups took a second Newton step
 /// about as often as not (the lane solver takes one for all its lanes while any one needs it); landing them
-/// after the first cut the polar decomposition's instructions by a quarter (README, "Speed", stop 31). Unlike
-/// a later landing in every pass (above), the lane and scalar solvers' contact-pair counts stay within the bound
-/// of `tests/lanes.rs`: the last pass's rotations, which the substep's positions keep, are polished as before.
+/// after the first cut the polar decomposition's instructions by a quarter (`docs/performance-history.md`,
+/// stop 31). Unlike a later landing in every pass (above), the lane and scalar solvers' contact-pair counts stay
+/// within the bound of `tests/lanes.rs`: the last pass's rotations, which the substep's positions keep, are
+/// polished as before.
 pub(crate) const ROUGH_LANDING_ANGLE: f32 = 1e-1;
 /// Relative size of the Hessian's smallest pivot below which it counts as singular.
 pub(crate) const MIN_PIVOT: f32 = 1e-4;
@@ -125,7 +126,7 @@ fn newton_step(s: &Mat3A, g: Vec3, trace: f32) -> Option<Vec3> {
 ///
 /// Against the exponential's series (`math::exp_small`) this takes the series out of the iteration's chain of
 /// dependent operations: on the lane solver's iteration, 105.5 against 136 cycles of `llvm-mca -mcpu=znver3`
-/// (`tools/instruction_mix.py --body`, README "Speed").
+/// (`tools/instruction_mix.py --body`, `docs/performance-history.md`).
 #[inline]
 fn turn(e: Vec3) -> Quat {
     if e.length_squared() > LONG_TURN * LONG_TURN {

@@ -421,7 +421,7 @@ fn match_shape(
         // Uniform masses cancel out of the group matrix. Its position terms `sum (p_k - c) r_k^T` are taken
         // relative to the middle particle instead of the centre `c`: the rest offsets `r_k` sum to zero, so
         // that changes only rounding, the middle particle's term vanishes, and the matrix does not wait for the
-        // centre's division (README, "Speed", stop 31).
+        // centre's division (`docs/performance-history.md`, stop 31).
         let (c, a) = if full {
             let hi = i + 1;
             let m_hi = orientation_term(hi);

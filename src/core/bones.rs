@@ -4,14 +4,15 @@
 //! of `perf record -e cpu-clock target/release/examples/scene_cost 120 1000x16 views`. Here a loop over a block of
 //! joints, whose body is one joint's arithmetic on plain arrays, runs them side by side in vector registers. That
 //! arithmetic is glam's, operation for operation and grouped as glam groups its sums (the lane kernel's mirrors
-//! in `lanes::scalar` where they agree with glam; the quaternion product and normalisation below where they do
-//! not), so the result has the same bits; the joints more than a right angle from their segment take
-//! [`math::swing_to`] itself.
+//! in `lanes::scalar` where they agree with glam; the quaternion product and normalisation of
+//! [`glam_order`](super::glam_order) where they do not), so the result has the same bits; the joints more than a
+//! right angle from their segment take [`math::swing_to`] itself.
 
 use glam::{Quat, Vec3};
 use multiversion::multiversion;
 
-use super::lanes::scalar::{Quaternion, cross, direction, dot, rotate, sub};
+use super::glam_order;
+use super::lanes::scalar::{cross, direction, dot, rotate, sub};
 use super::math::swing_to;
 
 /// Joints per block.
@@ -42,7 +43,7 @@ pub fn swing_onto_segments(orientations: &[Quat], axes: &[Vec3], positions: &[Ve
             // `math::swing_to`'s single-precision arc within a right angle.
             let at = rotate(q[lane], axis[lane]);
             let (cos, turn) = (dot(at, unit), cross(at, unit));
-            swung[lane] = normalize_as_glam(mul_as_glam([turn[0], turn[1], turn[2], 1.0 + cos], q[lane]));
+            swung[lane] = glam_order::normalize(glam_order::mul([turn[0], turn[1], turn[2], 1.0 + cos], q[lane]));
             along[lane] = unit;
             found[lane] = exists;
             // Not within a right angle, or NaN: `!(cos > 0.0)`.
@@ -60,25 +61,6 @@ pub fn swing_onto_segments(orientations: &[Quat], axes: &[Vec3], positions: &[Ve
     if let Some(last) = n.checked_sub(1) {
         out[last] = orientations[last];
     }
-}
-
-/// glam's SSE2 `Quat * Quat` (rtm's `quat_mul`): its sums grouped as glam groups them, which is not the lane
-/// kernel's order (`lanes::scalar::mul`).
-#[inline(always)]
-fn mul_as_glam([ax, ay, az, aw]: Quaternion, [bx, by, bz, bw]: Quaternion) -> Quaternion {
-    [
-        (aw * bx + ax * bw) + (ay * bz - az * by),
-        (aw * by - ax * bz) + (ay * bw + az * bx),
-        (aw * bz + ax * by) + (az * bw - ay * bx),
-        (aw * bw - ax * bx) - (ay * by + az * bz),
-    ]
-}
-
-/// glam's SSE2 `Quat::normalize`: the length from `(x² + z²) + (y² + w²)`, and a division by it.
-#[inline(always)]
-fn normalize_as_glam(q: Quaternion) -> Quaternion {
-    let length = ((q[0] * q[0] + q[2] * q[2]) + (q[1] * q[1] + q[3] * q[3])).sqrt();
-    [q[0] / length, q[1] / length, q[2] / length, q[3] / length]
 }
 
 #[cfg(test)]

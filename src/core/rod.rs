@@ -10,6 +10,7 @@ use super::inextensible::{self, ConstraintScratch, SolveMemory};
 use super::math::{Transform, align_hemisphere, exp_small, log_small, nlerp_shorter};
 use super::params::{ChainParams, EngineSettings};
 use super::polar::{extract_rotation, landing_angle};
+use super::rest_carry::carry_orientations;
 use super::shape::Shape;
 
 /// Warm-started rotation extraction (Newton steps where the problem is well conditioned) reaches float
@@ -330,8 +331,9 @@ pub fn carry_to_new_rest(
     let share_f64 = share as f64;
     for j in 1..n {
         x[j] = x[j] + (target[j] - x[j]) * share_f64;
-        let carried = (q[j] * old_orientations[j].inverse() * new_orientations[j]).normalize();
-        q[j] = nlerp_shorter(q[j], carried, share);
+    }
+    if n > 1 {
+        carry_orientations(&mut q[1..], &old_orientations[1..], &new_orientations[1..], share);
     }
 }
 

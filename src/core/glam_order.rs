@@ -1,0 +1,43 @@
+//! glam's quaternion arithmetic on plain arrays, operation for operation and with its sums grouped as glam's
+//! SSE2 code groups them, so that a loop over several joints, which the compiler can run side by side in vector
+//! registers, computes the bits that glam computes one joint at a time ([`bones`](super::bones),
+//! [`rest_carry`](super::rest_carry)). The lane kernel's own mirrors (`lanes::scalar`) group some sums
+//! differently.
+
+use super::lanes::scalar::Quaternion;
+
+/// `Quat * Quat` (rtm's `quat_mul`).
+#[inline(always)]
+pub fn mul([ax, ay, az, aw]: Quaternion, [bx, by, bz, bw]: Quaternion) -> Quaternion {
+    [
+        (aw * bx + ax * bw) + (ay * bz - az * by),
+        (aw * by - ax * bz) + (ay * bw + az * bx),
+        (aw * bz + ax * by) + (az * bw - ay * bx),
+        (aw * bw - ax * bx) - (ay * by + az * bz),
+    ]
+}
+
+/// `Quat::dot`: `(x x' + z z') + (y y' + w w')`.
+#[inline(always)]
+pub fn dot(a: Quaternion, b: Quaternion) -> f32 {
+    (a[0] * b[0] + a[2] * b[2]) + (a[1] * b[1] + a[3] * b[3])
+}
+
+/// `Quat::normalize`: the length from [`dot`] of itself, and a division by it.
+#[inline(always)]
+pub fn normalize(q: Quaternion) -> Quaternion {
+    let length = dot(q, q).sqrt();
+    [q[0] / length, q[1] / length, q[2] / length, q[3] / length]
+}
+
+/// `Quat::conjugate` (and `Quat::inverse`, which is it).
+#[inline(always)]
+pub fn conjugate([x, y, z, w]: Quaternion) -> Quaternion {
+    [-x, -y, -z, w]
+}
+
+/// `a * s + b * t`, as `Quat * f32` and `Quat + Quat`.
+#[inline(always)]
+pub fn mix(a: Quaternion, s: f32, b: Quaternion, t: f32) -> Quaternion {
+    [a[0] * s + b[0] * t, a[1] * s + b[1] * t, a[2] * s + b[2] * t, a[3] * s + b[3] * t]
+}

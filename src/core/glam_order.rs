@@ -2,7 +2,9 @@
 //! SSE2 code groups them, so that a loop over several joints, which the compiler can run side by side in vector
 //! registers, computes the bits that glam computes one joint at a time ([`bones`](super::bones),
 //! [`rest_carry`](super::rest_carry)). The lane kernel's own mirrors (`lanes::scalar`) group some sums
-//! differently.
+//! differently. This is glam's SSE2 code as this crate builds it for x86-64 (no `target-cpu=native`, so no FMA);
+//! built with FMA, or on another architecture, glam may round some of these sums differently, and the tests
+//! that compare these mirrors with glam bit for bit would say so.
 
 use super::lanes::scalar::Quaternion;
 

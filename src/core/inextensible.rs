@@ -492,6 +492,7 @@ fn project_relinearized(
     let rows = &mut s.rows[..m];
     let mut previous_worst = f64::INFINITY;
     let mut lost = f64::INFINITY;
+    // No bonds: nothing to meet (and `TwistedPass` needs a middle bond).
     if m == 0 {
         return true;
     }
@@ -723,7 +724,8 @@ impl BondRow {
     }
 }
 
-/// The running state of one root-to-tip pass of [`newton_along_directions`].
+/// The running state of one root-to-tip pass of [`newton_along_directions`]; also [`TwistedPass`]'s summary of
+/// its two sweeps, whose `sweep` then holds only their smallest pivot (its last row's entries mean nothing).
 #[derive(Default)]
 struct ForwardPass {
     /// Largest relative error `|F_k| / l_k^2`.
@@ -826,9 +828,11 @@ impl Sweep {
 /// One elimination of the Gauss-Newton projection, from both ends of the chain at once (a twisted
 /// factorisation): the bonds below the middle one root to tip, those above it tip to root, a row of each
 /// sweep in turn, and the middle bond's row from both. Each sweep is a chain of dependent divisions; the two
-/// halves overlap, where one sweep over every bond waits on each division in turn (the projection's time on
-/// long chains, whose solves keep ending in it, goes mostly to that wait). The same system and the same
-/// checks as [`ForwardPass`]; other roundings.
+/// halves overlap, where one sweep over every bond waits on each division in turn (on long chains whose solves
+/// keep ending in the projection, about half of its time went to the elimination and the back substitution).
+/// The same system, and the same tests on its errors and pivots as [`ForwardPass`]'s, but not the same pivots:
+/// for a straight chain, in units of a bond's squared length, the middle row's is about `2/m` where the
+/// one-ended elimination's stay near 1: far above the relative [`MIN_PIVOT`] (1e-7) for any chain length.
 struct TwistedPass {
     /// Both sweeps' and the middle row's errors, diagonal and pivots, as one pass over every bond has them.
     summary: ForwardPass,

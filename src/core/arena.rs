@@ -151,9 +151,13 @@ impl<T> Arena<T> {
     }
 
     /// The live values at two different indices, both mutable.
-    pub fn pair_at_mut(&mut self, first: usize, second: usize) -> Option<(&mut T, &mut T)> {
-        let [a, b] = self.slots.get_disjoint_mut([first, second]).ok()?;
-        Some((a.value.as_mut()?, b.value.as_mut()?))
+    /// The live values at `indices` (distinct), all at once; `None` if any is out of range, repeated or empty.
+    pub fn many_at_mut<const N: usize>(&mut self, indices: [usize; N]) -> Option<[&mut T; N]> {
+        let slots = self.slots.get_disjoint_mut(indices).ok()?;
+        if slots.iter().any(|slot| slot.value.is_none()) {
+            return None;
+        }
+        Some(slots.map(|slot| slot.value.as_mut().expect("every slot was checked to be live")))
     }
 
     pub fn id_at(&self, index: usize) -> Option<Id<T>> {
@@ -194,5 +198,19 @@ mod tests {
         assert_eq!(a.index_of(id2), Some(0));
         assert!(a.get(id).is_none(), "the old id must not reach the reused slot");
         assert_eq!(a.len(), 1);
+    }
+
+    #[test]
+    fn many_values_at_once_only_when_distinct_in_range_and_live() {
+        let mut a: Arena<i32> = Arena::new(Kind::Chain, 7);
+        let ids: Vec<Id<i32>> = (0..4).map(|v| a.insert(v).unwrap()).collect();
+        let [x, y] = a.many_at_mut([3, 1]).unwrap();
+        (*x, *y) = (*x + 10, *y + 10);
+        assert_eq!((a.at(3), a.at(1)), (Some(&13), Some(&11)));
+        assert!(a.many_at_mut([0, 0]).is_none(), "repeated");
+        assert!(a.many_at_mut([0, 4]).is_none(), "out of range");
+        a.remove(ids[2]);
+        assert!(a.many_at_mut([0, 1, 2, 3]).is_none(), "an empty slot");
+        assert_eq!(a.many_at_mut([0, 1, 3]).map(|values| values.map(|v| *v)), Some([0, 11, 13]));
     }
 }

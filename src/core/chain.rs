@@ -342,21 +342,24 @@ impl Chain {
         }
     }
 
-    /// [`update_rest`](Self::update_rest) of two chains, their decodes side by side
-    /// ([`EncodedShape::decode_pair_into`]): the same results as one after the other, sooner.
-    pub(crate) fn update_rest_pair(first: &mut Chain, second: &mut Chain, view: Option<Vec3>) {
-        match (first.blend_rest(view), second.blend_rest(view)) {
-            (true, true) => {
-                EncodedShape::decode_pair_into(
-                    (&first.blended, &first.frame, &mut first.rest.positions),
-                    (&second.blended, &second.frame, &mut second.rest.positions),
-                );
-                first.orient_rest();
-                second.orient_rest();
+    /// [`update_rest`](Self::update_rest) of `N` chains, their decodes side by side when every one is due
+    /// ([`EncodedShape::decode_side_by_side`]): the same results as one after the other, sooner.
+    pub(crate) fn update_rest_together<const N: usize>(mut chains: [&mut Chain; N], view: Option<Vec3>) {
+        let due = chains.each_mut().map(|chain| chain.blend_rest(view));
+        if due.iter().all(|&due| due) {
+            EncodedShape::decode_side_by_side(chains.each_mut().map(|chain| {
+                let chain: &mut Chain = chain;
+                (&chain.blended, &chain.frame, &mut chain.rest.positions[..])
+            }));
+            for chain in chains {
+                chain.orient_rest();
             }
-            (true, false) => first.update_rest_after_blend(),
-            (false, true) => second.update_rest_after_blend(),
-            (false, false) => {}
+        } else {
+            for (chain, due) in chains.into_iter().zip(due) {
+                if due {
+                    chain.update_rest_after_blend();
+                }
+            }
         }
     }
 
@@ -614,48 +617,64 @@ mod tests {
 
     use super::*;
 
-    #[test]
-    fn a_pair_updates_its_rest_shapes_as_each_alone() {
-        // Chains of 5 and 9 joints hanging down, each with a view shape from +X that leans it sideways.
-        let chain = |joints: usize, lean: f32| {
-            let at = |i: usize, x: f32| Transform::new(Vec3::new(x * i as f32, -0.1 * i as f32, 0.0), Quat::IDENTITY);
-            let straight: Vec<Transform> = (0..joints).map(|i| at(i, 0.0)).collect();
-            let leaning: Vec<Transform> = (0..joints).map(|i| at(i, lean)).collect();
-            let mut chain = Chain::new(ChainParams::default(), &straight).unwrap();
-            let encoded = chain.encode_view_shape(&leaning).unwrap();
-            let weighting = ViewWeighting { direction: Vec3::X, influence: 2.0 };
-            chain.push_view(ViewShape { id: ViewShapeId::from_bits(1), weighting, encoded });
-            chain
-        };
-        let bits = |c: &Chain| {
-            let positions = c.rest.positions.iter().flat_map(|p| p.to_array());
-            let orientations = c.rest.orientations.iter().flat_map(|q| q.to_array());
-            (positions.chain(orientations).map(f32::to_bits).collect::<Vec<_>>(), c.rest_changed)
-        };
+    /// A chain of `joints` joints hanging down, with a view shape from +X that leans it sideways by `lean`.
+    fn leaning_chain(joints: usize, lean: f32) -> Chain {
+        let at = |i: usize, x: f32| Transform::new(Vec3::new(x * i as f32, -0.1 * i as f32, 0.0), Quat::IDENTITY);
+        let straight: Vec<Transform> = (0..joints).map(|i| at(i, 0.0)).collect();
+        let leaning: Vec<Transform> = (0..joints).map(|i| at(i, lean)).collect();
+        let mut chain = Chain::new(ChainParams::default(), &straight).unwrap();
+        let encoded = chain.encode_view_shape(&leaning).unwrap();
+        let weighting = ViewWeighting { direction: Vec3::X, influence: 2.0 };
+        chain.push_view(ViewShape { id: ViewShapeId::from_bits(1), weighting, encoded });
+        chain
+    }
+
+    fn rest_bits(c: &Chain) -> (Vec<u32>, bool) {
+        let positions = c.rest.positions.iter().flat_map(|p| p.to_array());
+        let orientations = c.rest.orientations.iter().flat_map(|q| q.to_array());
+        (positions.chain(orientations).map(f32::to_bits).collect(), c.rest_changed)
+    }
+
+    /// `N` chains of different lengths updated together, each due or not (already blended for this view) in
+    /// every combination, give each chain the bits of its own update.
+    fn assert_updated_together_as_each_alone<const N: usize>(lengths: [usize; N]) {
         let view = Some(Vec3::new(0.6, 0.0, 0.8));
-        // Each chain due or not (already blended for this view), in every combination the engine meets.
-        for (first_due, second_due) in [(true, true), (true, false), (false, true)] {
-            let (mut first, mut second) = (chain(5, 0.03), chain(9, -0.05));
-            for (chain, due) in [(&mut first, first_due), (&mut second, second_due)] {
-                if !due {
-                    chain.update_rest(view);
-                    chain.rest_changed = false;
-                }
-            }
-            let (mut first_alone, mut second_alone) = (chain(5, 0.03), chain(9, -0.05));
-            for (chain, due) in [(&mut first_alone, first_due), (&mut second_alone, second_due)] {
-                if !due {
-                    chain.update_rest(view);
-                    chain.rest_changed = false;
-                }
+        let lean = |i: usize| 0.03 - 0.02 * i as f32;
+        for due_mask in 0..(1u32 << N) {
+            let due: [bool; N] = std::array::from_fn(|i| due_mask & (1 << i) != 0);
+            let prepared = || -> Vec<Chain> {
+                (0..N)
+                    .map(|i| {
+                        let mut chain = leaning_chain(lengths[i], lean(i));
+                        if !due[i] {
+                            chain.update_rest(view);
+                            chain.rest_changed = false;
+                        }
+                        chain
+                    })
+                    .collect()
+            };
+            let mut together = prepared();
+            let mut alone = prepared();
+            for chain in &mut alone {
                 chain.update_rest(view);
             }
-            Chain::update_rest_pair(&mut first, &mut second, view);
-            assert!(first.rest_changed == first_due && second.rest_changed == second_due);
-            assert_eq!(bits(&first), bits(&first_alone));
-            assert_eq!(bits(&second), bits(&second_alone));
-            assert!(!first.rest_update_due(view) && !second.rest_update_due(view));
+            let group: [&mut Chain; N] = together.get_disjoint_mut(std::array::from_fn(|i| i)).unwrap();
+            Chain::update_rest_together(group, view);
+            for i in 0..N {
+                assert_eq!(together[i].rest_changed, due[i], "chains {lengths:?}, due {due:?}");
+                assert_eq!(rest_bits(&together[i]), rest_bits(&alone[i]), "chains {lengths:?}, due {due:?}");
+                assert!(!together[i].rest_update_due(view));
+            }
         }
+    }
+
+    #[test]
+    fn chains_updated_together_update_their_rest_shapes_as_each_alone() {
+        assert_updated_together_as_each_alone([5, 9]);
+        assert_updated_together_as_each_alone([9, 5]);
+        assert_updated_together_as_each_alone([5, 9, 3, 16]);
+        assert_updated_together_as_each_alone([16, 16, 16, 16]);
     }
 
     #[test]

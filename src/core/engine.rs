@@ -695,15 +695,10 @@ impl Engine {
         self.order.iter().take(READ_AHEAD).for_each(|slot| rest_update_ahead(&self.chains, Some(slot)));
         for (index, &slot) in self.order.iter().enumerate() {
             rest_update_ahead(&self.chains, self.order.get(index + READ_AHEAD));
-            // A chain whose rest shape is due for an update takes the next chain's along
-            // (`Chain::update_rest_pair`), whose own `update_rest` below then has nothing to do.
-            if let Some(&next) = self.order.get(index + 1)
-                && let Some((chain, next)) = self.chains.pair_at_mut(slot as usize, next as usize)
-                && chain.enabled
-                && next.enabled
-                && chain.rest_update_due(self.view)
-            {
-                Chain::update_rest_pair(chain, next, self.view);
+            // A chain whose rest shape is due for an update takes the next three chains' along, or the next one's
+            // (`Chain::update_rest_together`), whose own `update_rest` below then has nothing to do.
+            if !update_rests_together::<4>(&self.order, &mut self.chains, index, view) {
+                update_rests_together::<2>(&self.order, &mut self.chains, index, view);
             }
             let chain = self.chains.at_mut(slot as usize).expect("live");
             let mut rebase = rebase;
@@ -1269,4 +1264,25 @@ fn validate_influence(k: f32) -> Result<()> {
     } else {
         Err(Error::invalid_argument(format!("influence must be finite and > 0, got {k}")))
     }
+}
+
+/// [`Chain::update_rest_together`] of the `N` chains from `index` in `order`, if they all exist and are
+/// enabled and the first one's rest shape is due for an update; whether it ran.
+fn update_rests_together<const N: usize>(
+    order: &[u32],
+    chains: &mut Arena<Chain>,
+    index: usize,
+    view: Option<Vec3>,
+) -> bool {
+    let Some(slots) = order.get(index..index + N) else {
+        return false;
+    };
+    let Some(group) = chains.many_at_mut::<N>(std::array::from_fn(|i| slots[i] as usize)) else {
+        return false;
+    };
+    if !group.iter().all(|chain| chain.enabled) || !group[0].rest_update_due(view) {
+        return false;
+    }
+    Chain::update_rest_together(group, view);
+    true
 }

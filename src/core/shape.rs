@@ -149,25 +149,24 @@ impl EncodedShape {
         }
     }
 
-    /// Two shapes' [`decode_into`](Self::decode_into), joint by joint side by side: each decode is a chain of
+    /// `N` shapes' [`decode_into`](Self::decode_into), joint by joint side by side: each decode is a chain of
     /// dependent steps (a rotation and a normalisation per joint) that alone leaves the core waiting on their
-    /// latency; two independent chains overlap. Each shape's arithmetic is its own decode's: the same bits.
-    pub fn decode_pair_into(
-        (first, first_frame, first_positions): (&Self, &ShapeFrame, &mut [Vec3]),
-        (second, second_frame, second_positions): (&Self, &ShapeFrame, &mut [Vec3]),
-    ) {
-        let mut first_walk = Walk::new(first_frame, first_positions);
-        let mut second_walk = Walk::new(second_frame, second_positions);
-        let both = first.bends.len().min(second.bends.len());
-        for j in 0..both {
-            first_walk.step(&first.bends[j], first_frame, first_positions, j);
-            second_walk.step(&second.bends[j], second_frame, second_positions, j);
+    /// latency; independent chains overlap. Each shape's arithmetic is its own decode's: the same bits.
+    pub fn decode_side_by_side<const N: usize>(mut jobs: [(&Self, &ShapeFrame, &mut [Vec3]); N]) {
+        let mut walks: [Walk; N] = std::array::from_fn(|i| {
+            let (_, frame, positions) = &mut jobs[i];
+            Walk::new(frame, positions)
+        });
+        let common = jobs.iter().map(|(shape, ..)| shape.bends.len()).min().unwrap_or(0);
+        for j in 0..common {
+            for (walk, (shape, frame, positions)) in walks.iter_mut().zip(jobs.iter_mut()) {
+                walk.step(&shape.bends[j], frame, positions, j);
+            }
         }
-        for (j, bend) in first.bends.iter().enumerate().skip(both) {
-            first_walk.step(bend, first_frame, first_positions, j);
-        }
-        for (j, bend) in second.bends.iter().enumerate().skip(both) {
-            second_walk.step(bend, second_frame, second_positions, j);
+        for (walk, (shape, frame, positions)) in walks.iter_mut().zip(jobs.iter_mut()) {
+            for (j, bend) in shape.bends.iter().enumerate().skip(common) {
+                walk.step(bend, frame, positions, j);
+            }
         }
     }
 
@@ -282,20 +281,30 @@ mod tests {
             prop_assert_eq!(back.orientations, shape.orientations);
         }
 
-        /// Two shapes decoded side by side, of any lengths, give each the bits of its own decode.
+        /// Shapes decoded side by side, of any lengths, give each the bits of its own decode.
         #[test]
-        fn a_pair_decodes_as_each_alone(first in arb_chain(), second in arb_chain()) {
+        fn shapes_side_by_side_decode_as_each_alone(first in arb_chain(), second in arb_chain(), third in arb_chain()) {
             let encoded = |joints: &[Transform]| {
                 let shape = Shape::from_joints(joints).unwrap();
                 let frame = ShapeFrame::from_base(&shape);
                 (EncodedShape::encode(&shape, frame.reference), frame)
             };
-            let ((a, a_frame), (b, b_frame)) = (encoded(&first), encoded(&second));
-            let (mut a_pair, mut b_pair) = (vec![Vec3::NAN; first.len()], vec![Vec3::NAN; second.len()]);
-            EncodedShape::decode_pair_into((&a, &a_frame, &mut a_pair), (&b, &b_frame, &mut b_pair));
+            let ((a, a_frame), (b, b_frame), (c, c_frame)) = (encoded(&first), encoded(&second), encoded(&third));
             let bits = |positions: &[Vec3]| positions.iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+            let (mut a_pair, mut b_pair) = (vec![Vec3::NAN; first.len()], vec![Vec3::NAN; second.len()]);
+            EncodedShape::decode_side_by_side([(&a, &a_frame, &mut a_pair[..]), (&b, &b_frame, &mut b_pair[..])]);
             prop_assert_eq!(bits(&a_pair), bits(&a.decode(&a_frame).positions));
             prop_assert_eq!(bits(&b_pair), bits(&b.decode(&b_frame).positions));
+            let mut quad: Vec<Vec<Vec3>> = [first.len(), second.len(), third.len(), first.len()]
+                .iter()
+                .map(|&n| vec![Vec3::NAN; n])
+                .collect();
+            let [q0, q1, q2, q3] = quad.get_disjoint_mut([0, 1, 2, 3]).unwrap();
+            EncodedShape::decode_side_by_side([(&a, &a_frame, &mut q0[..]), (&b, &b_frame, &mut q1[..]), (&c, &c_frame, &mut q2[..]), (&a, &a_frame, &mut q3[..])]);
+            prop_assert_eq!(bits(&quad[0]), bits(&a.decode(&a_frame).positions));
+            prop_assert_eq!(bits(&quad[1]), bits(&b.decode(&b_frame).positions));
+            prop_assert_eq!(bits(&quad[2]), bits(&c.decode(&c_frame).positions));
+            prop_assert_eq!(bits(&quad[3]), bits(&a.decode(&a_frame).positions));
         }
     }
 }

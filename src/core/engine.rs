@@ -1266,8 +1266,9 @@ fn validate_influence(k: f32) -> Result<()> {
     }
 }
 
-/// [`Chain::update_rest_together`] of the `N` chains from `index` in `order`, if they all exist and are
-/// enabled and the first one's rest shape is due for an update; whether it ran.
+/// [`Chain::update_rest_together`] of the `N` chains from `index` in `order`, if the first one's rest shape
+/// is due for an update and they all exist and are enabled; whether it ran. A scene whose rest shapes stay
+/// (no view shapes, a still camera) stops at the first chain's check.
 fn update_rests_together<const N: usize>(
     order: &[u32],
     chains: &mut Arena<Chain>,
@@ -1277,10 +1278,13 @@ fn update_rests_together<const N: usize>(
     let Some(slots) = order.get(index..index + N) else {
         return false;
     };
+    if !chains.at(slots[0] as usize).is_some_and(|chain| chain.enabled && chain.rest_update_due(view)) {
+        return false;
+    }
     let Some(group) = chains.many_at_mut::<N>(std::array::from_fn(|i| slots[i] as usize)) else {
         return false;
     };
-    if !group.iter().all(|chain| chain.enabled) || !group[0].rest_update_due(view) {
+    if !group.iter().all(|chain| chain.enabled) {
         return false;
     }
     Chain::update_rest_together(group, view);

@@ -457,7 +457,7 @@ pub fn solve_fallback(p: &mut [DVec3], lengths: &[f32], multipliers: &[f64], s: 
 fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> Solved {
     let m = lengths.len();
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
-    // The Gauss-Newton projection moves `p` and overwrites the multipliers: keep both for the exact one.
+    // The Gauss-Newton projection moves `p`: the exact one starts from the positions and multipliers given.
     s.implicit.begin(p, &s.newton.mu[..m]);
     for k in 0..m {
         s.current_bonds[k] = p[k + 1] - p[k];
@@ -488,7 +488,9 @@ fn project_relinearized(
     let m = d.len();
     let p = &mut p[..m + 1];
     let (l2, inv_l2) = (&length_squared[..m], &inverse_length_squared[..m]);
-    let (mu, c_prime, d_prime, step) = (&mut s.mu[..m], &mut s.c_prime[..m], &mut s.d_prime[..m], &mut s.step[..m]);
+    // Each iteration's multipliers are a step of their own, from the bonds as they are then: `step` holds them
+    // (`s.mu`, the failed direct solve's, stays as it was).
+    let (c_prime, d_prime, step) = (&mut s.c_prime[..m], &mut s.d_prime[..m], &mut s.step[..m]);
     let rows = &mut s.rows[..m];
     let mut previous_worst = f64::INFINITY;
     let mut lost = f64::INFINITY;
@@ -514,9 +516,7 @@ fn project_relinearized(
         if !pass.pivots_usable() {
             return false;
         }
-        // Each iteration's multipliers are a step of their own, from the bonds as they are now.
-        mu.fill(0.0);
-        if !twisted.back_substitute(c_prime, d_prime, mu, step) {
+        if !twisted.back_substitute(c_prime, d_prime, step) {
             return false;
         }
         // As in the direct solve: a step predicted to land within the tolerance ends the projection, without
@@ -524,7 +524,7 @@ fn project_relinearized(
         // is exact here too).
         let landed = pass.worst <= LANDING_GATE && error_after_step(d, mobility, step, inv_l2) <= TOLERANCE;
         for j in 1..=m {
-            p[j] += shift(d, mobility, mu, j);
+            p[j] += shift(d, mobility, step, j);
         }
         if landed {
             return true;
@@ -887,29 +887,25 @@ impl TwistedPass {
         Self { summary, twist, middle }
     }
 
-    /// The passes back, from the middle bond to both ends side by side: adds the step to `mu` and stores it
-    /// in `step`. Returns `false` if the step is not finite (as [`back_substitute`]).
+    /// The passes back, from the middle bond to both ends side by side, into `step`. Returns `false` if the
+    /// step is not finite (as [`back_substitute`]).
     #[inline(always)]
-    fn back_substitute(&self, c_prime: &[f64], d_prime: &[f64], mu: &mut [f64], step: &mut [f64]) -> bool {
-        let (m, twist) = (mu.len(), self.twist);
+    fn back_substitute(&self, c_prime: &[f64], d_prime: &[f64], step: &mut [f64]) -> bool {
+        let (m, twist) = (step.len(), self.twist);
         let paired = m - 1 - twist;
         step[twist] = self.middle;
-        mu[twist] += self.middle;
         let (mut toward_root, mut toward_tip) = (self.middle, self.middle);
         for i in 1..=paired {
             let below = twist - i;
             toward_root = d_prime[below] - c_prime[below] * toward_root;
             step[below] = toward_root;
-            mu[below] += toward_root;
             let above = twist + i;
             toward_tip = d_prime[above] - c_prime[above] * toward_tip;
             step[above] = toward_tip;
-            mu[above] += toward_tip;
         }
         if twist > paired {
             toward_root = d_prime[0] - c_prime[0] * toward_root;
             step[0] = toward_root;
-            mu[0] += toward_root;
         }
         // As in `back_substitute`: a non-finite entry makes every later one of its pass non-finite.
         toward_root.is_finite() && toward_tip.is_finite()
@@ -973,16 +969,15 @@ mod tests {
             one_ended.row(k, d[k], d, mobility, l2[k], inv_l2[k], &mut c_prime, &mut d_prime);
         }
         assert!(back_substitute(&c_prime, &d_prime, &mut mu, &mut step));
-        let (mut c_twisted, mut d_twisted, mut mu_twisted, mut step_twisted) = (zeros(), zeros(), zeros(), zeros());
+        let (mut c_twisted, mut d_twisted, mut step_twisted) = (zeros(), zeros(), zeros());
         let mut rows = vec![BondRow::default(); m];
         let twisted = TwistedPass::run(d, mobility, l2, &inv_l2, &mut rows, &mut c_twisted, &mut d_twisted);
-        assert!(twisted.back_substitute(&c_twisted, &d_twisted, &mut mu_twisted, &mut step_twisted));
+        assert!(twisted.back_substitute(&c_twisted, &d_twisted, &mut step_twisted));
         let largest = step.iter().fold(0.0f64, |a, s| a.max(s.abs()));
         assert!(largest > 0.0, "m {m}");
         for k in 0..m {
             let (one, two) = (step[k], step_twisted[k]);
             assert!((one - two).abs() <= 1e-9 * largest, "m {m}, bond {k}: {one} vs {two}");
-            assert_eq!(mu_twisted[k], two);
         }
         assert_eq!(twisted.summary.worst, one_ended.worst, "m {m}");
         assert_eq!(twisted.summary.scale, one_ended.scale, "m {m}");

@@ -143,10 +143,7 @@ impl EncodedShape {
 
     /// Forward kinematics: root, then rotate the running direction by each `r_j` and step `l_j`.
     pub fn decode_into(&self, frame: &ShapeFrame, positions: &mut [Vec3]) {
-        let mut walk = Walk::new(frame, positions);
-        for (j, bend) in self.bends.iter().enumerate() {
-            walk.step(bend, frame, positions, j);
-        }
+        Self::decode_side_by_side([(self, frame, positions)]);
     }
 
     /// `N` shapes' [`decode_into`](Self::decode_into), joint by joint side by side: each decode is a chain of

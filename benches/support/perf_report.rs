@@ -363,18 +363,18 @@ pub const SUBSTEP_WORK: [Work; 5] = [
     // f64), orientation predict: scaled turn (3), exponential (26), product (28), normalise (13).
     Work::new("predict", (91.0, 3.0), [1.0, 1.0, 0.0, 0.0]),
     // Per iteration (2 at default) of an interior group: 2 orientation terms (product 28, to matrix 24, weight
-    // 9) = 122; centroid (9 adds, 3 divisions: f64); the outer and lower members' offsets from the middle one
-    // (6 f64), their outer products (18) and the sum of 5 matrices (36); the polar step: its guard (20, the
-    // matrix's norm: a square root), one step (rotation matrix 24, S = R^T A 45, gradient and trace 5,
-    // Mueller's step 5 (a division), convergence 5, the Newton step 58 (a division), the Cayley turn 3,
-    // product 28, renormalise 13 = 186), the final matrix (24); goals for 3 particles (matrix times offset 15
-    // each; in f64 the goal and the pull, 12 each); orientation: product (28) and nlerp (33: a normalise). Per
-    // iteration 512 f32 and 54 f64, times 2; per iteration 4 single-precision divisions (Mueller's, Newton's,
-    // the two normalisations') and 3 square roots (the guard's, the normalisations'), 3 double-precision
-    // divisions (the centroid's). Until stop 31 this counted the exponential's series (26) that stop 30's
-    // Cayley turn replaced, the offset and outer product of the middle member, and 3 divisions and 2 square
-    // roots per iteration.
-    Work::new("shape matching, 2 iterations", (1024.0, 108.0), [8.0, 6.0, 6.0, 0.0]),
+    // 9) = 122; centroid (9 adds, 3 multiplications by a third: f64); the outer and lower members' offsets from
+    // the middle one (6 f64), their outer products (18) and the sum of 5 matrices (36); the polar step: its
+    // guard (20, the matrix's norm: a square root), one step (rotation matrix 24, S = R^T A 45, gradient and
+    // trace 5, Mueller's step 5 (a division), convergence 5, the Newton step 58 (a division), the Cayley turn
+    // 3, product 28, renormalise 13 = 186), the final matrix (24); goals for 3 particles (matrix times offset
+    // 15 each; in f64 the goal and the pull, 12 each); orientation: product (28) and nlerp (33: a normalise).
+    // Per iteration 512 f32 and 54 f64, times 2; per iteration 4 single-precision divisions (Mueller's,
+    // Newton's, the two normalisations') and 3 square roots (the guard's, the normalisations'). Until stop 31
+    // this counted the exponential's series (26) that stop 30's Cayley turn replaced, the offset and outer
+    // product of the middle member, and 3 divisions and 2 square roots per iteration; until stop 41 the
+    // centroid divided by 3 (3 double-precision divisions per iteration).
+    Work::new("shape matching, 2 iterations", (1024.0, 108.0), [8.0, 6.0, 0.0, 0.0]),
     // Start bonds (3, once per substep); per iteration and bond, all f64: the forward pass row (bond 3,
     // residual 7, three dot products 15, elimination 9 with its pivot's division = 34), back substitution (2),
     // the error after the step (18), applying the multipliers (12) = 66, times 2.

@@ -17,6 +17,12 @@ use super::shape::Shape;
 /// precision in 2-3 iterations and stops early once converged; the cap only bounds the worst case.
 pub(crate) const POLAR_ITERATIONS: u32 = 8;
 
+/// A third, in double precision: a full group's centre is its members' sum times this rather than divided by 3,
+/// which the compiler may not do itself (the two round differently, by at most one unit in the last place). The
+/// divider takes double-precision divisions at a seventeenth of the multipliers' rate on stop 41's AVX2 machine
+/// (`docs/performance.md`, machine table), and the centre took three per group, iteration and lane.
+pub(crate) const THIRD: f64 = 1.0 / 3.0;
+
 /// Most rounds of (lengths, contacts) in the last solver iteration; they stop once the contacts move
 /// nothing by more than `CONTACT_SETTLED` of the shortest segment.
 pub(crate) const FINAL_CONTACT_ROUNDS: u32 = 16;
@@ -428,7 +434,7 @@ fn match_shape(
             let hi = i + 1;
             let m_hi = orientation_term(hi);
             carried = Some(m_hi);
-            let c = (DVec3::ZERO + p[lo] + p[i] + p[hi]) / 3.0;
+            let c = (DVec3::ZERO + p[lo] + p[i] + p[hi]) * THIRD;
             let a =
                 m_lo + outer((p[lo] - p[i]).as_vec3a(), r_lo) + m_mid + m_hi + outer((p[hi] - p[i]).as_vec3a(), r_hi);
             (c, a)

@@ -13,6 +13,7 @@
 use super::polar;
 use super::scalar::{Mat, Quaternion, Vec, dot4, from_quat, mul};
 use super::simd::{D, DV3, F, M3, Q, V3};
+use crate::core::rod::THIRD;
 
 type DVec = [f64; 3];
 
@@ -71,7 +72,7 @@ fn centre_and_spans<const L: usize, const FULL: bool>(
         to_lower.set(lane, to_f32(sub(lower, middle)));
         if FULL {
             to_upper.set(lane, to_f32(sub(upper, middle)));
-            let centre = |k: usize| (0.0 + lower[k] + middle[k] + upper[k]) / 3.0;
+            let centre = |k: usize| (0.0 + lower[k] + middle[k] + upper[k]) * THIRD;
             c.set(lane, [centre(0), centre(1), centre(2)]);
         } else {
             let centre = |k: usize| (0.0 + lower[k] + middle[k]) / 2.0;

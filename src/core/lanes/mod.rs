@@ -174,7 +174,9 @@ pub(crate) const FEWEST_IN_A_GROUP: usize = 3;
 /// twice the chains per instruction. The kernel is bound by the latency of its chains of dependent operations
 /// (shape matching goes root to tip), so that shortens its time per chain: 0.76x that of groups of 8 with
 /// AVX2 (`step_cost 1000 16 10 sway` built at 28d84ce and at its parent, run alternately 16 times: median
-/// ratio). With AVX2 alone (two 256-bit halves per operation) groups of 16 were no faster than groups of 8.
+/// ratio). With AVX2 alone (two 256-bit halves per operation) groups of 16 were no faster than groups of 8, and
+/// on a Zen 1, which splits each 256-bit operation again, slower: 1.09x the time of `scene_cost 40 1000x16
+/// lanes` (`tools/ab.sh --abba`, stop 41).
 fn group_widths(len: usize, sixteen: bool) -> impl Iterator<Item = (usize, usize)> {
     let sixteens = if sixteen { len / 16 } else { 0 };
     let rest = len - 16 * sixteens;

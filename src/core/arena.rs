@@ -150,7 +150,6 @@ impl<T> Arena<T> {
         self.slots.get_mut(index)?.value.as_mut()
     }
 
-    /// The live values at two different indices, both mutable.
     /// The live values at `indices` (distinct), all at once; `None` if any is out of range, repeated or empty.
     pub fn many_at_mut<const N: usize>(&mut self, indices: [usize; N]) -> Option<[&mut T; N]> {
         let slots = self.slots.get_disjoint_mut(indices).ok()?;

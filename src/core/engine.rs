@@ -696,8 +696,10 @@ impl Engine {
         for (index, &slot) in self.order.iter().enumerate() {
             rest_update_ahead(&self.chains, self.order.get(index + READ_AHEAD));
             // A chain whose rest shape is due for an update takes the next three chains' along, or the next one's
-            // (`Chain::update_rest_together`), whose own `update_rest` below then has nothing to do.
-            if !update_rests_together::<4>(&self.order, &mut self.chains, index, view) {
+            // (`Chain::update_rest_together`), whose own `update_rest` below then has nothing to do. A scene whose
+            // rest shapes stay (no view shapes, a still camera) pays this one check per chain.
+            let due = self.chains.at(slot as usize).is_some_and(|chain| chain.enabled && chain.rest_update_due(view));
+            if due && !update_rests_together::<4>(&self.order, &mut self.chains, index, view) {
                 update_rests_together::<2>(&self.order, &mut self.chains, index, view);
             }
             let chain = self.chains.at_mut(slot as usize).expect("live");
@@ -1266,9 +1268,8 @@ fn validate_influence(k: f32) -> Result<()> {
     }
 }
 
-/// [`Chain::update_rest_together`] of the `N` chains from `index` in `order`, if the first one's rest shape
-/// is due for an update and they all exist and are enabled; whether it ran. A scene whose rest shapes stay
-/// (no view shapes, a still camera) stops at the first chain's check.
+/// [`Chain::update_rest_together`] of the `N` chains from `index` in `order`, if they all exist and are enabled
+/// (the caller has found the first one's rest update due); whether it ran.
 fn update_rests_together<const N: usize>(
     order: &[u32],
     chains: &mut Arena<Chain>,
@@ -1278,9 +1279,6 @@ fn update_rests_together<const N: usize>(
     let Some(slots) = order.get(index..index + N) else {
         return false;
     };
-    if !chains.at(slots[0] as usize).is_some_and(|chain| chain.enabled && chain.rest_update_due(view)) {
-        return false;
-    }
     let Some(group) = chains.many_at_mut::<N>(std::array::from_fn(|i| slots[i] as usize)) else {
         return false;
     };

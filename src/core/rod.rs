@@ -6,7 +6,7 @@ use glam::{DVec3, Mat3A, Quat, Vec3, Vec3A};
 
 use super::arcs::ArcColumns;
 use super::collision::{ContactInput, SegmentBounds, collide, pre_stabilise};
-use super::inextensible::{self, ConstraintScratch, SolveMemory};
+use super::inextensible::{self, ConstraintScratch, SlidingMemory, SolveMemory};
 use super::math::{Transform, align_hemisphere, exp_small, log_small, nlerp_shorter};
 use super::params::{ChainParams, EngineSettings};
 use super::polar::{extract_rotation, landing_angle};
@@ -265,6 +265,7 @@ pub fn substep(
             // A collider pushing hard (a swinging arm) moves a few particles far in one substep; the rest of
             // the chain follows through more rounds of lengths then contacts. The substep ends on contacts.
             if iteration + 1 == iterations {
+                let mut sliding_memory = SlidingMemory::default();
                 for _ in 1..FINAL_CONTACT_ROUNDS {
                     if !pass.touching || pass.deepest <= settled {
                         break;
@@ -272,7 +273,7 @@ pub fn substep(
                     // Joints the contacts gave a normal slide on their colliders here, so the lengths do not
                     // undo those contacts round after round (bug 9 in docs/robustness.md).
                     let direct = if sliding {
-                        inextensible::solve_sliding(p, lengths, normals, constraints)
+                        inextensible::solve_sliding(p, lengths, normals, constraints, &mut sliding_memory)
                     } else {
                         inextensible::solve_prepared(p, lengths, constraints)
                     };

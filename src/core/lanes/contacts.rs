@@ -10,7 +10,7 @@ use super::simd::{DV3, Mask};
 use crate::core::buffers::reserve_total;
 use crate::core::collider::ColliderSweep;
 use crate::core::collision::{self, ContactInput, ContactPass};
-use crate::core::inextensible;
+use crate::core::inextensible::{self, SlidingMemory};
 use crate::core::rod::FINAL_CONTACT_ROUNDS;
 
 /// What one lane's chain needs for its contacts during a step.
@@ -38,6 +38,8 @@ pub(crate) struct LaneContacts {
     pub normals: Vec<Vec3>,
     /// Some particle has a normal in `normals`.
     pub sliding: bool,
+    /// How the current substep's sliding solves ended (`inextensible::solve_sliding`).
+    pub sliding_memory: SlidingMemory,
 }
 
 impl LaneContacts {
@@ -67,6 +69,7 @@ impl LaneContacts {
         self.sweeps.extend(self.candidates.iter().map(|&c| row[c]));
         self.starts_clear = s > 0 && self.pass.is_some_and(|pass| !pass.touching);
         self.pass = None;
+        self.sliding_memory = SlidingMemory::default();
     }
 }
 
@@ -166,7 +169,8 @@ pub fn solve_sliding<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) -> Ma
         lane_lengths.clear();
         lane_lengths.extend(lengths[..n - 1].iter().map(|l| l.0[lane]));
         inextensible::prepare(lane_x, lane_lengths, constraints);
-        fell_back.0[lane] = !inextensible::solve_sliding(lane_p, lane_lengths, &contacts[lane].normals, constraints);
+        let LaneContacts { normals, sliding_memory, .. } = &mut contacts[lane];
+        fell_back.0[lane] = !inextensible::solve_sliding(lane_p, lane_lengths, normals, constraints, sliding_memory);
         write_back(lane_p, lane, &mut p[..n]);
     }
     fell_back

@@ -295,7 +295,12 @@ impl Machine {
             .ok()
             .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned());
         Self {
-            cpu_model: field("model name").unwrap_or_else(|| "unknown".into()),
+            // The family and model tell CPU generations apart that share a name (AMD's first- and
+            // third-generation Zen are both "AMD EPYC" in a virtual machine; stops 41 and 42 measured one each).
+            cpu_model: match (field("model name"), field("cpu family"), field("model")) {
+                (Some(name), Some(family), Some(model)) => format!("{name}, family {family}, model {model}"),
+                (name, _, _) => name.unwrap_or_else(|| "unknown".into()),
+            },
             processors: cpuinfo.lines().filter(|l| l.starts_with("processor")).count(),
             available_parallelism: std::thread::available_parallelism().map_or(1, |n| n.get()),
             mhz: field("cpu MHz").and_then(|v| v.parse().ok()),
@@ -636,7 +641,7 @@ impl Report {
     fn machine_section(&self, md: &mut String, machine: &Machine, simd_path: &str) {
         md.push_str("## Machine\n\n| fact | value |\n|---|---|\n");
         let rows = [
-            ("CPU model (/proc/cpuinfo)", machine.cpu_model.clone()),
+            ("CPU model, family and model (/proc/cpuinfo)", machine.cpu_model.clone()),
             (
                 "logical CPUs (nproc)",
                 format!("{} ({} available to the process)", machine.processors, machine.available_parallelism),

@@ -214,7 +214,7 @@ pub fn solve_again(
 /// docs/robustness.md) the restricted direct solve fails round after round (on the report's 0.8 m rope of
 /// 1000 joints with colliders, in 86 % of the rounds, and in 92 % of those after a round where it failed):
 /// after a round whose restricted direct solve failed, the substep's next rounds go straight to the restricted
-/// projection, except every [`RETRY_DIRECT`]-th such round in a row. A failed direct solve leaves `p` as it was and the
+/// projection, except every [`RETRY_DIRECT`]-th round in a row without it. A failed direct solve leaves `p` as it was and the
 /// projection does not read its multipliers, so a skipped direct solve that would have failed changes no bit;
 /// one that would have met the lengths leaves it to the projection, restricted alike. (The projection is
 /// never skipped: where it meets the lengths, the sliding joints keep the contacts that bug 9's fix needs,
@@ -231,55 +231,32 @@ pub fn solve_sliding(
     debug_assert!(p.len() == m + 1 && normals.len() == m + 1 && s.start_bonds.len() >= m);
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
     let sliding = Sliding(normals);
-    let retry = memory.streak.is_multiple_of(RETRY_DIRECT);
-    if (memory.last == SlidingEnd::Direct || retry)
+    if memory.direct_failed.is_multiple_of(RETRY_DIRECT)
         && newton_along_directions(p, &s.start_bonds[..m], &sliding, l2, inv_l2, &mut s.newton, Start::Cold)
     {
-        memory.ended(SlidingEnd::Direct);
+        memory.direct_failed = 0;
         return true;
     }
+    // Wrapping: see `relinearized_after`.
+    memory.direct_failed = memory.direct_failed.wrapping_add(1);
     // The Gauss-Newton projection moves `p` as it goes: keep the given positions for the unrestricted solve.
     s.newton.corrected[..=m].copy_from_slice(p);
     for k in 0..m {
         s.current_bonds[k] = p[k + 1] - p[k];
     }
-    if project_relinearized(p, &mut s.current_bonds[..m], &sliding, l2, inv_l2, &mut s.newton) {
-        memory.ended(SlidingEnd::Projected);
-        return false;
+    if !project_relinearized(p, &mut s.current_bonds[..m], &sliding, l2, inv_l2, &mut s.newton) {
+        p.copy_from_slice(&s.newton.corrected[..=m]);
+        solve_prepared(p, lengths, s);
     }
-    p.copy_from_slice(&s.newton.corrected[..=m]);
-    solve_prepared(p, lengths, s);
-    memory.ended(SlidingEnd::Unrestricted);
     false
 }
 
-/// How the sliding solves ([`solve_sliding`]) of a chain's contact rounds have been ending in the current
-/// substep (each substep starts with a new one).
+/// What the sliding solves ([`solve_sliding`]) of a chain's contact rounds have learnt in the current substep
+/// (each substep starts with a new one).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SlidingMemory {
-    last: SlidingEnd,
-    /// Sliding solves in a row that ended as `last` (0: none yet).
-    streak: u32,
-}
-
-/// Which solve met the lengths in a sliding solve.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-enum SlidingEnd {
-    /// The direct solve restricted to the sliding joints' planes.
-    #[default]
-    Direct,
-    /// The Gauss-Newton projection so restricted.
-    Projected,
-    /// Neither: [`solve_prepared`], contacts aside. (The next round skips the direct solve here too.)
-    Unrestricted,
-}
-
-impl SlidingMemory {
-    fn ended(&mut self, end: SlidingEnd) {
-        // Wrapping: see `relinearized_after`.
-        self.streak = if end == self.last { self.streak.wrapping_add(1) } else { 1 };
-        self.last = end;
-    }
+    /// Rounds in a row whose restricted direct solve failed or was skipped.
+    direct_failed: u32,
 }
 
 /// Which moves the solve may give each particle (its inverse mass as a projection).
@@ -1168,13 +1145,9 @@ mod tests {
         assert!(max_stretch(&p, &lengths) < 1e-6, "{}", max_stretch(&p, &lengths));
     }
 
-    /// A fine rope (400 joints of 1 mm in a gentle S) whose every joint the prediction moved by a few tenths of
-    /// a segment: the Gauss-Newton projection loses its way, the exact projection converges, and its answer is
-    /// nearer the prediction than the direct solve's (both keep the lengths; the projection is the nearest
-    /// such positions).
-    #[test]
-    fn fine_rope_projection_converges_where_gauss_newton_does_not() {
-        let n = 400;
+    /// A fine rope of `n` joints of 1 mm in a gentle S (positions, lengths) and a prediction that moves each
+    /// dynamic joint by `push` times a few tenths of a segment.
+    fn fine_rope(n: usize, push: f64) -> (Vec<DVec3>, Vec<f32>, Vec<DVec3>) {
         let x: Vec<DVec3> = (0..n)
             .map(|i| {
                 let s = i as f64 * 1e-3;
@@ -1182,14 +1155,19 @@ mod tests {
             })
             .collect();
         let lengths: Vec<f32> = x.windows(2).map(|w| (w[1] - w[0]).length() as f32).collect();
-        let predicted: Vec<DVec3> = x
-            .iter()
-            .enumerate()
-            .map(|(i, v)| {
-                let i = i as f64;
-                if i == 0.0 { *v } else { *v + DVec3::new(2e-4 * (i * 0.05).sin(), -3e-4, 2e-4 * (i * 0.031).cos()) }
-            })
-            .collect();
+        let offset = |i: f64| DVec3::new(2e-4 * (i * 0.05).sin(), -3e-4, 2e-4 * (i * 0.031).cos()) * push;
+        let predicted = x.iter().enumerate().map(|(i, v)| if i == 0 { *v } else { *v + offset(i as f64) }).collect();
+        (x, lengths, predicted)
+    }
+
+    /// A fine rope (400 joints of 1 mm in a gentle S) whose every joint the prediction moved by a few tenths of
+    /// a segment: the Gauss-Newton projection loses its way, the exact projection converges, and its answer is
+    /// nearer the prediction than the direct solve's (both keep the lengths; the projection is the nearest
+    /// such positions).
+    #[test]
+    fn fine_rope_projection_converges_where_gauss_newton_does_not() {
+        let n = 400;
+        let (x, lengths, predicted) = fine_rope(n, 1.0);
         let distance = |p: &[DVec3]| p.iter().zip(&predicted).map(|(a, b)| (*a - *b).length_squared()).sum::<f64>();
         let mut s = ConstraintScratch::default();
         let m = n - 1;
@@ -1216,26 +1194,12 @@ mod tests {
     }
 
     /// A sliding solve that skips the restricted direct solve its memory says will fail gives the bits of one
-    /// that runs and fails it: the fine rope of the test above, bent further, with two joints sliding on planes
-    /// (where the restricted projection fails too).
+    /// that runs and fails it: the fine rope of the test above, pushed further, with two joints sliding on
+    /// planes.
     #[test]
     fn a_sliding_solve_that_skips_failing_solves_keeps_the_bits() {
         let n = 400;
-        let x: Vec<DVec3> = (0..n)
-            .map(|i| {
-                let s = i as f64 * 1e-3;
-                DVec3::new(0.02 * (s * 20.0).sin(), -s, 0.0)
-            })
-            .collect();
-        let lengths: Vec<f32> = x.windows(2).map(|w| (w[1] - w[0]).length() as f32).collect();
-        let predicted: Vec<DVec3> = x
-            .iter()
-            .enumerate()
-            .map(|(i, v)| {
-                let i = i as f64;
-                if i == 0.0 { *v } else { *v + DVec3::new(4e-3 * (i * 0.05).sin(), -6e-3, 4e-3 * (i * 0.031).cos()) }
-            })
-            .collect();
+        let (x, lengths, predicted) = fine_rope(n, 20.0);
         let mut normals = vec![Vec3::ZERO; n];
         normals[120] = Vec3::X;
         normals[260] = Vec3::new(0.6, 0.0, 0.8);
@@ -1243,23 +1207,22 @@ mod tests {
         let mut memory = SlidingMemory::default();
         let mut first = predicted.clone();
         prepare(&x, &lengths, &mut s);
-        assert!(!solve_sliding(&mut first, &lengths, &normals, &mut s, &mut memory));
-        assert_eq!(memory, SlidingMemory { last: SlidingEnd::Unrestricted, streak: 1 }, "both restricted solves fail");
-        // (Where only the direct solve fails, the projection ends it: `Projected`, which skips alike.)
+        assert!(!solve_sliding(&mut first, &lengths, &normals, &mut s, &mut memory), "the direct solve fails");
+        assert_eq!(memory.direct_failed, 1);
         assert!(max_stretch(&first, &lengths) < 1e-6, "{}", max_stretch(&first, &lengths));
-        // Again from the same positions: now straight to the restricted projection, to the same bits.
+        // Again from the same positions: now without the direct solve, to the same bits.
         let mut again = predicted.clone();
         prepare(&x, &lengths, &mut s);
         assert!(!solve_sliding(&mut again, &lengths, &normals, &mut s, &mut memory));
         assert!(crate::core::rod::same_bits(&first, &again));
-        assert_eq!(memory, SlidingMemory { last: SlidingEnd::Unrestricted, streak: 2 });
+        assert_eq!(memory.direct_failed, 2);
         // The retry every `RETRY_DIRECT` rounds runs the direct solve, and fails it again.
-        memory.streak = RETRY_DIRECT;
+        memory.direct_failed = RETRY_DIRECT;
         let mut retried = predicted.clone();
         prepare(&x, &lengths, &mut s);
         assert!(!solve_sliding(&mut retried, &lengths, &normals, &mut s, &mut memory));
         assert!(crate::core::rod::same_bits(&first, &retried));
-        assert_eq!(memory.streak, RETRY_DIRECT + 1);
+        assert_eq!(memory.direct_failed, RETRY_DIRECT + 1);
     }
 
     /// A chain whose restricted direct solve meets the lengths keeps trying it first.
@@ -1276,7 +1239,14 @@ mod tests {
         prepare(&x, &lengths, &mut s);
         assert!(solve_sliding(&mut p, &lengths, &normals, &mut s, &mut memory));
         assert!(max_stretch(&p, &lengths) < 1e-6, "{}", max_stretch(&p, &lengths));
-        assert_eq!(memory, SlidingMemory { last: SlidingEnd::Direct, streak: 1 });
+        assert_eq!(memory.direct_failed, 0);
+        // A memory that would retry now (after `RETRY_DIRECT` rounds without) forgets its failures on success.
+        let mut memory = SlidingMemory { direct_failed: RETRY_DIRECT };
+        let mut q = x.clone();
+        q[1..].iter_mut().for_each(|v| *v -= DVec3::Y * 1.7e-4);
+        prepare(&x, &lengths, &mut s);
+        assert!(solve_sliding(&mut q, &lengths, &normals, &mut s, &mut memory));
+        assert_eq!(memory.direct_failed, 0);
     }
 
     /// The exact projection started from the chain's last correction (`ImplicitScratch::begin_shifted`): a

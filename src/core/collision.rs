@@ -14,7 +14,7 @@ use super::collider::{ColliderShape, ColliderSweep};
 
 /// Below this share of a root segment's length from its kinematic end, a contact cannot be resolved by
 /// turning the segment (the lever would multiply the push); the tip particle is tested instead.
-const ROOT_LEVER_MIN: f32 = 0.25;
+pub(crate) const ROOT_LEVER_MIN: f32 = 0.25;
 
 /// A joint that the chain from the root could lift clear of a collider only by pointing within 60 degrees of
 /// straight out (cos 60° = 0.5 of its rest length along the chain gained as distance) is left inside: near
@@ -193,6 +193,13 @@ pub struct ContactPass {
     pub sliding: bool,
 }
 
+impl ContactPass {
+    /// A pass that tested `tested` pairs and touched nothing.
+    pub(crate) const fn nothing(tested: u64) -> Self {
+        Self { tested, touching: false, deepest: 0.0, moved_start: false, sliding: false }
+    }
+}
+
 fn collide_plane(
     start: &mut [DVec3],
     p: &mut [DVec3],
@@ -264,6 +271,9 @@ fn collide_inside(
     ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start, sliding: false }
 }
 
+/// One pass of the sphere or capsule `sweep` over the chain (see [`collide`]); `bounds` are the pass's
+/// quick-reject bounds and `drift` how far the pass has moved things since they were computed. The lane
+/// solver's pass (`lanes::outside`) does the same with its lanes side by side.
 fn collide_outside(
     start: &mut [DVec3],
     p: &mut [DVec3],
@@ -273,98 +283,159 @@ fn collide_outside(
     drift: &mut f64,
     normals: Option<&mut [Vec3]>,
 ) -> ContactPass {
-    let mut touching = false;
-    let mut deepest = 0.0f32;
-    let mut moved_start = false;
-    let mut sliding = false;
-    let (radius, half_height) = sweep.shape.capsule().expect("outside colliders are spheres or capsules");
-    let axis = (Vec3::new(0.0, -half_height, 0.0), Vec3::new(0.0, half_height, 0.0));
-    // Quick reject, in world space and conservative: a segment whose every point stays farther from the
-    // collider's centre than the collider's reach, over the whole substep, cannot touch it. Saves the frame
-    // changes and closest-point tests for the many segments of a long chain far from a collider.
-    let centre = sweep.end.centre;
-    let collider_travel = (sweep.end.centre - sweep.start.centre).length();
-    let solid = (radius + half_height) as f64;
-    // A root clear of the collider by joint 1's radius holds nothing: one world-space test for most chains.
-    let near_root = (radius + half_height + input.radii[1]) as f64;
-    let (held, root_distance) = if (p[0] - centre).length_squared() < near_root * near_root {
-        let root_distance = distance_from_axis(sweep.end.to_local(p[0]), half_height);
-        let reach = |j: usize| radius + input.radii[j];
-        (held_by_root(input.lengths, |j, along| root_distance + along * CLEARING_SLANT < reach(j)), root_distance)
-    } else {
-        (Held::NONE, f32::INFINITY)
-    };
-    let collider = OutsideCollider { centre, collider_travel, solid, radius, half_height, axis, held, root_distance };
-    // The segment leaving the joints the root holds: pushing its far end alone would stretch the held run, which
-    // the lengths would undo round after round (bug 9 in docs/robustness.md). The run turns about the root
-    // instead, and its last joint slides on the collider in the contact rounds' lengths solves. The loop below
-    // then tests the segment like any other: it pushes what depth the turns left, or all of it where the run
-    // cannot turn. (Outside the loop: inside, its code made the loop slower for every chain. When the root holds
-    // every joint, there is no such segment.)
+    let mut pass = ContactPass::nothing(p.len() as u64 - 1);
+    let collider = OutsideCollider::new(sweep, input, p[0]);
+    let held = collider.held;
+    // (Outside the loop: inside, its code made the loop slower for every chain. When the root holds every joint,
+    // there is no such segment.)
     if held.joints > 0 && held.joints < bounds.len() {
-        let k = held.joints;
-        let found = segment_contact(k, bounds[k], start, p, sweep, input, &collider, *drift);
-        let turned = found.as_ref().and_then(|found| turn_held_run(start, p, k, found, sweep, &collider, input.slop));
-        if let (Some(found), Some(turned)) = (found, turned) {
-            touching = true;
-            deepest = deepest.max(found.contact.depth);
-            *drift += turned.drift;
-            moved_start |= turned.moved_start;
-            if let Some(normals) = normals {
-                normals[k + 1] = turned.normal;
-                sliding = true;
-            }
-        }
+        turn_held(start, p, sweep, input, &collider, bounds[held.joints], drift, normals, &mut pass);
     }
     // Segments before `held` join joints the root holds inside (or the root itself): nothing to test.
     for (i, &bound) in bounds[held.joints..].iter().enumerate() {
         let k = held.joints + i;
-        let Some(SegmentContact { t, point, before, contact, .. }) =
-            segment_contact(k, bound, start, p, sweep, input, &collider, *drift)
-        else {
+        let mut ends = SegmentEnds::of(start, p, k);
+        let Some(found) = segment_contact(k, bound, &ends, sweep, input, &collider, *drift) else {
             continue;
         };
-        let Contact { normal, depth, overlapping_at_start } = contact;
-        touching = true;
-        deepest = deepest.max(depth);
-        let correction = contact.correction(point, before, input.friction);
-        // Move the segment's two ends so that the point at `t` moves by `correction` (unit masses; the root's
-        // inverse mass is 0).
-        let (wa, wb) = (if k == 0 { 0.0 } else { 1.0 - t }, t);
-        let scale = 1.0 / (wa * wa + wb * wb);
-        let world = sweep.end.direction_to_world(correction * scale);
-        p[k] += world * wa as f64;
-        p[k + 1] += world * wb as f64;
-        *drift += world.length() * (wa + wb) as f64;
-        if overlapping_at_start {
-            moved_start = true;
-            let push = sweep.end.direction_to_world(normal * (depth * scale));
-            start[k] += push * wa as f64;
-            start[k + 1] += push * wb as f64;
-            *drift += push.length() * (wa + wb) as f64;
+        *drift += resolve_segment(k, &found, sweep, input.friction, &mut ends, &mut pass);
+        ends.store(start, p, k);
+    }
+    pass
+}
+
+/// The segment leaving the joints the root holds inside `collider` (`bound` its quick-reject bound): pushing its
+/// far end alone would stretch the held run, which the lengths would undo round after round (bug 9 in
+/// docs/robustness.md). The run turns about the root instead, and its last joint slides on the collider in the
+/// contact rounds' lengths solves (its normal goes to `normals`). The pass then tests the segment like any
+/// other: it pushes what depth the turns left, or all of it where the run cannot turn.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn turn_held(
+    start: &mut [DVec3],
+    p: &mut [DVec3],
+    sweep: &ColliderSweep,
+    input: &ContactInput<'_>,
+    collider: &OutsideCollider,
+    bound: (DVec3, f64),
+    drift: &mut f64,
+    normals: Option<&mut [Vec3]>,
+    pass: &mut ContactPass,
+) {
+    let k = collider.held.joints;
+    let found = segment_contact(k, bound, &SegmentEnds::of(start, p, k), sweep, input, collider, *drift);
+    let turned = found.as_ref().and_then(|found| turn_held_run(start, p, k, found, sweep, collider, input.slop));
+    if let (Some(found), Some(turned)) = (found, turned) {
+        pass.touching = true;
+        pass.deepest = pass.deepest.max(found.contact.depth);
+        *drift += turned.drift;
+        pass.moved_start |= turned.moved_start;
+        if let Some(normals) = normals {
+            normals[k + 1] = turned.normal;
+            pass.sliding = true;
         }
     }
-    ContactPass { tested: p.len() as u64 - 1, touching, deepest, moved_start, sliding }
+}
+
+/// The ends of segment `k` of a chain: their positions at the start of the substep and now.
+#[derive(Clone, Copy)]
+pub(crate) struct SegmentEnds {
+    pub start: [DVec3; 2],
+    pub p: [DVec3; 2],
+}
+
+impl SegmentEnds {
+    #[inline(always)]
+    fn of(start: &[DVec3], p: &[DVec3], k: usize) -> Self {
+        Self { start: [start[k], start[k + 1]], p: [p[k], p[k + 1]] }
+    }
+
+    #[inline(always)]
+    fn store(self, start: &mut [DVec3], p: &mut [DVec3], k: usize) {
+        [start[k], start[k + 1]] = self.start;
+        [p[k], p[k + 1]] = self.p;
+    }
+}
+
+/// Resolves the contact `found` of segment `k` (`ends`) with `sweep`: moves the segment's two ends so that its
+/// contact point moves out, with friction, and its start positions too where the point was inside already at
+/// the start of the substep. Records the contact in `pass`; returns how far it moved things (the drift).
+#[inline(always)]
+pub(crate) fn resolve_segment(
+    k: usize,
+    found: &SegmentContact,
+    sweep: &ColliderSweep,
+    friction: f32,
+    ends: &mut SegmentEnds,
+    pass: &mut ContactPass,
+) -> f64 {
+    let SegmentContact { t, point, before, contact, .. } = *found;
+    let Contact { normal, depth, overlapping_at_start } = contact;
+    pass.touching = true;
+    pass.deepest = pass.deepest.max(depth);
+    let correction = contact.correction(point, before, friction);
+    // Move the segment's two ends so that the point at `t` moves by `correction` (unit masses; the root's
+    // inverse mass is 0).
+    let (wa, wb) = (if k == 0 { 0.0 } else { 1.0 - t }, t);
+    let scale = 1.0 / (wa * wa + wb * wb);
+    let world = sweep.end.direction_to_world(correction * scale);
+    ends.p[0] += world * wa as f64;
+    ends.p[1] += world * wb as f64;
+    let mut drift = world.length() * (wa + wb) as f64;
+    if overlapping_at_start {
+        pass.moved_start = true;
+        let push = sweep.end.direction_to_world(normal * (depth * scale));
+        ends.start[0] += push * wa as f64;
+        ends.start[1] += push * wb as f64;
+        drift += push.length() * (wa + wb) as f64;
+    }
+    drift
 }
 
 /// An outside collider as [`segment_contact`] tests segments against it.
-struct OutsideCollider {
-    centre: DVec3,
-    collider_travel: f64,
+#[derive(Clone, Copy)]
+pub(crate) struct OutsideCollider {
+    pub centre: DVec3,
+    pub collider_travel: f64,
     /// Its radius plus half height: how far its surface reaches from its centre.
-    solid: f64,
-    radius: f32,
-    half_height: f32,
+    pub solid: f64,
+    pub radius: f32,
+    pub half_height: f32,
     /// Its axis segment, in its own frame.
     axis: (Vec3, Vec3),
-    held: Held,
+    /// The joints the chain's root holds inside it.
+    pub held: Held,
     /// The root's distance from the axis (infinite when the root holds nothing).
     root_distance: f32,
 }
 
+impl OutsideCollider {
+    /// The sphere or capsule `sweep` for a chain rooted at `root`.
+    #[inline(always)]
+    pub fn new(sweep: &ColliderSweep, input: &ContactInput<'_>, root: DVec3) -> Self {
+        let (radius, half_height) = sweep.shape.capsule().expect("outside colliders are spheres or capsules");
+        let axis = (Vec3::new(0.0, -half_height, 0.0), Vec3::new(0.0, half_height, 0.0));
+        // Quick reject, in world space and conservative: a segment whose every point stays farther from the
+        // collider's centre than the collider's reach, over the whole substep, cannot touch it. Saves the frame
+        // changes and closest-point tests for the many segments of a long chain far from a collider.
+        let centre = sweep.end.centre;
+        let collider_travel = (sweep.end.centre - sweep.start.centre).length();
+        let solid = (radius + half_height) as f64;
+        // A root clear of the collider by joint 1's radius holds nothing: one world-space test for most chains.
+        let near_root = (radius + half_height + input.radii[1]) as f64;
+        let (held, root_distance) = if (root - centre).length_squared() < near_root * near_root {
+            let root_distance = distance_from_axis(sweep.end.to_local(root), half_height);
+            let reach = |j: usize| radius + input.radii[j];
+            (held_by_root(input.lengths, |j, along| root_distance + along * CLEARING_SLANT < reach(j)), root_distance)
+        } else {
+            (Held::NONE, f32::INFINITY)
+        };
+        Self { centre, collider_travel, solid, radius, half_height, axis, held, root_distance }
+    }
+}
+
 /// Where a segment meets an outside collider: at `t` along it, the material point now at `point` and at
 /// `before` at the start of the substep (both in the collider's frame), whose reach there is `reach`.
-struct SegmentContact {
+pub(crate) struct SegmentContact {
     t: f32,
     point: Vec3,
     before: Vec3,
@@ -372,15 +443,13 @@ struct SegmentContact {
     contact: Contact,
 }
 
-/// The contact of segment `k` (its quick-reject bound `bound`) with `collider`, if any. `drift` is how far the
-/// pass has moved things since the bounds were computed.
-#[allow(clippy::too_many_arguments)]
+/// The contact of segment `k` (its quick-reject bound `bound`, its ends `ends`) with `collider`, if any. `drift`
+/// is how far the pass has moved things since the bounds were computed.
 #[inline(always)]
-fn segment_contact(
+pub(crate) fn segment_contact(
     k: usize,
     (midpoint, segment_reach): (DVec3, f64),
-    start: &[DVec3],
-    p: &[DVec3],
+    ends: &SegmentEnds,
     sweep: &ColliderSweep,
     input: &ContactInput<'_>,
     collider: &OutsideCollider,
@@ -391,7 +460,7 @@ fn segment_contact(
     if (midpoint - centre).length_squared() > clear * clear {
         return None;
     }
-    let (a, b) = (sweep.end.to_local(p[k]), sweep.end.to_local(p[k + 1]));
+    let (a, b) = (sweep.end.to_local(ends.p[0]), sweep.end.to_local(ends.p[1]));
     let (mut t, _) = closest_between_segments((a, b), axis);
     // The root is kinematic: a contact next to it could only be met by a large turn of the segment.
     if k == 0 && t < ROOT_LEVER_MIN {
@@ -404,7 +473,7 @@ fn segment_contact(
     }
     let point = a.lerp(b, t);
     let reach = reach_at(t);
-    let before = sweep.start.to_local(start[k].lerp(start[k + 1], t as f64));
+    let before = sweep.start.to_local(ends.start[0].lerp(ends.start[1], t as f64));
     let contact = contact_outside(before, point, reach, half_height, input.slop)?;
     Some(SegmentContact { t, point, before, reach, contact })
 }
@@ -503,8 +572,8 @@ fn held_by_root(lengths: &[f32], mut held: impl FnMut(usize, f32) -> bool) -> He
 /// What [`held_by_root`] found: the first `joints` dynamic joints are held; the last of them is `along` m of
 /// rest length from the root.
 #[derive(Clone, Copy)]
-struct Held {
-    joints: usize,
+pub(crate) struct Held {
+    pub joints: usize,
     along: f32,
 }
 
@@ -653,7 +722,8 @@ fn ray_capsule(from: Vec3, to: Vec3, radius: f32, half_height: f32) -> Option<(V
 
 /// Parameters `(s, t)` of the closest points of segments `p` and `q` (Ericson, Real-Time Collision
 /// Detection, 5.1.9), each in [0, 1].
-fn closest_between_segments(p: (Vec3, Vec3), q: (Vec3, Vec3)) -> (f32, f32) {
+#[inline(always)]
+pub(crate) fn closest_between_segments(p: (Vec3, Vec3), q: (Vec3, Vec3)) -> (f32, f32) {
     let (d1, d2) = (p.1 - p.0, q.1 - q.0);
     let r = p.0 - q.0;
     let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));

@@ -1,11 +1,14 @@
-//! The contact pass of a lane group: `collision`'s scalar code, one lane at a time, between the kernel's
-//! vector phases. Contacts are sparse (a few joints of a strand touch the head or a shoulder), branchy and
-//! different for every chain, so they stay scalar; what the lanes gain is the rest of the substep (shape
-//! matching and the lengths), which a chain near a collider would otherwise run on the scalar solver.
+//! The contact pass of a lane group, between the kernel's vector phases. Contacts are sparse (a few joints of a
+//! strand touch the head or a shoulder), branchy and different for every chain: each is resolved by
+//! `collision`'s scalar code. Against spheres and capsules, the lanes first screen every segment at once
+//! ([`outside`]); against other colliders the pass is `collision`'s, one lane at a time. The lanes also gain
+//! the rest of the substep (shape matching and the lengths), which a chain near a collider would otherwise run
+//! on the scalar solver.
 
 use glam::{DVec3, Vec3};
 
 use super::group::LaneGroup;
+use super::outside::{self, ScreenFn};
 use super::simd::{DV3, Mask};
 use crate::core::buffers::reserve_total;
 use crate::core::collider::ColliderSweep;
@@ -52,7 +55,7 @@ impl LaneContacts {
         reserve_total(&mut self.sweeps, colliders);
     }
 
-    fn input(&self) -> ContactInput<'_> {
+    pub(super) fn input(&self) -> ContactInput<'_> {
         ContactInput {
             colliders: &self.sweeps,
             radii: &self.radii,
@@ -116,20 +119,38 @@ pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) {
 /// One contact pass (`collision::collide`) on the lanes in `lanes`, moving their positions and, where a joint
 /// was inside already at the start of the substep, their start positions. An iteration's pass (`fresh`)
 /// forgets the contact normals of the passes before; a contact round's adds to them. Returns the pairs tested.
-pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, fresh: bool) -> u64 {
+///
+/// Lanes whose chains can touch only spheres and capsules (a character's head and limbs) take the pass in
+/// lanes ([`outside`]); the others (a ground plane, an inside collider) the scalar pass, one lane at a time.
+#[inline(always)]
+pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, fresh: bool, screen: Option<ScreenFn<L>>) -> u64 {
     let n = g.n;
     let mut tested = 0;
+    let mut in_lanes = Mask([false; L]);
     for lane in (0..L).filter(|&lane| lanes.0[lane]) {
-        let LaneGroup { x, p, lane_x, lane_p, contacts, segment_bounds, .. } = g;
-        extract(&x[..n], lane, lane_x);
-        extract(&p[..n], lane, lane_p);
-        let contact = &mut contacts[lane];
+        let contact = &mut g.contacts[lane];
         // All zero already unless some joint slid.
         if fresh && (contact.sliding || contact.normals.len() != n) {
             contact.normals.clear();
             contact.normals.resize(n, Vec3::ZERO);
             contact.sliding = false;
         }
+        in_lanes.0[lane] = screen.is_some() && contact.sweeps.iter().all(outside::is_outside);
+    }
+    if let Some(screen) = screen.filter(|_| in_lanes.any()) {
+        let passes = outside::collide(g, in_lanes, screen);
+        for lane in (0..L).filter(|&lane| in_lanes.0[lane]) {
+            let contact = &mut g.contacts[lane];
+            contact.sliding |= passes[lane].sliding;
+            contact.pass = Some(passes[lane]);
+            tested += passes[lane].tested;
+        }
+    }
+    for lane in (0..L).filter(|&lane| lanes.0[lane] && !in_lanes.0[lane]) {
+        let LaneGroup { x, p, lane_x, lane_p, contacts, segment_bounds, .. } = g;
+        extract(&x[..n], lane, lane_x);
+        extract(&p[..n], lane, lane_p);
+        let contact = &mut contacts[lane];
         // Out of `contact` for the pass, which reads the rest of it (a move: no allocation).
         let mut normals = std::mem::take(&mut contact.normals);
         let pass = collision::collide(lane_x, lane_p, &contact.input(), segment_bounds, &mut normals);

@@ -113,6 +113,12 @@ pub struct LaneGroup<const L: usize> {
     pub(super) memories: Vec<SolveMemory>,
     pub(super) constraints: ConstraintScratch,
     pub(super) segment_bounds: SegmentBounds,
+    /// The contact pass in lanes (`outside::collide`): each joint's collision radius and each segment's
+    /// quick-reject bound.
+    pub(super) contact_radii: Vec<F<L>>,
+    pub(super) contact_bounds: Vec<(DV3<L>, D<L>)>,
+    /// Per segment, the lanes whose segment may touch the collider at hand (`outside::screen_all`).
+    pub(super) contact_maybe: Vec<u32>,
 }
 
 /// `MultiplierHistory` on every lane.
@@ -231,6 +237,9 @@ impl<const L: usize> LaneGroup<L> {
         }
         self.constraints.reserve(n);
         self.segment_bounds.reserve(n);
+        fit(&mut self.contact_radii, n, F([0.0; L]));
+        fit(&mut self.contact_bounds, n, (DV3::ZERO, D([0.0; L])));
+        fit(&mut self.contact_maybe, n, 0);
     }
 
     /// Loads `chains[lane]` into every lane: quantity by quantity, each chain's array read as numbers and
@@ -366,6 +375,9 @@ impl<const L: usize> LaneGroup<L> {
         contact.sweeps.clear();
         contact.sweeps.reserve(colliders);
         find(&mut contact.candidates, &mut contact.radii);
+        for (row, &radius) in self.contact_radii.iter_mut().zip(&contact.radii) {
+            row.0[lane] = radius;
+        }
         contact.lengths.clear();
         if !contact.candidates.is_empty() {
             contact.lengths.extend(self.lengths[..self.n - 1].iter().map(|l| l.0[lane]));

@@ -30,6 +30,8 @@ pub struct Phases<const L: usize> {
     /// The render pose: the capture after substep `s`, and the output at fraction `t` ([`output`]).
     pub capture: fn(&mut LaneGroup<L>, usize),
     pub output: fn(&mut LaneGroup<L>, f32),
+    /// One contact pass on some lanes ([`contacts::collide`]); returns the pairs tested.
+    pub collide: fn(&mut LaneGroup<L>, Mask<L>, bool) -> u64,
 }
 
 impl<const L: usize> Phases<L> {
@@ -41,6 +43,7 @@ impl<const L: usize> Phases<L> {
         finish: |g| finish_substep(g, angular_velocities),
         capture: output::capture,
         output: output::write,
+        collide: |g, lanes, fresh| contacts::collide(g, lanes, fresh, None),
     };
 }
 
@@ -70,7 +73,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
     let mut pairs = 0;
     for iteration in 0..iterations {
         fell_back = fell_back.or(iterate(g, phases, iteration as usize));
-        pairs += contacts::collide(g, touching, true);
+        pairs += (phases.collide)(g, touching, true);
         start_bonds(g);
         if iteration + 1 == iterations {
             for _ in 1..FINAL_CONTACT_ROUNDS {
@@ -93,7 +96,7 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
                 if sliding.any() {
                     fell_back = fell_back.or(contacts::solve_sliding(g, sliding));
                 }
-                pairs += contacts::collide(g, again, false);
+                pairs += (phases.collide)(g, again, false);
                 start_bonds(g);
             }
         }

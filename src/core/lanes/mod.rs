@@ -9,8 +9,8 @@
 //!
 //! - [`simd`]: lane arithmetic; [`kernel`]: one substep of a group, whose phases are compiled one by one;
 //!   [`polar`], [`lengths`] and [`rotations`]: the parts written as loops over lanes, with one lane's
-//!   arithmetic in [`scalar`]; [`contacts`]: the contact pass, lane by lane; [`group`]: the buffers, loaded from
-//!   the chains and stored back by [`transpose`].
+//!   arithmetic in [`scalar`]; [`contacts`]: the contact pass ([`outside`] and [`screen_avx2`] for spheres and
+//!   capsules); [`group`]: the buffers, loaded from the chains and stored back by [`transpose`].
 //! - The wide copies of the kernel are compiled for AVX2 (groups of 8 and 4) and AVX-512 (groups of 16) next
 //!   to the portable (SSE2) one and chosen at run time by CPU-feature detection ([`multiversion`]); no build
 //!   needs `target-cpu=native`.
@@ -21,8 +21,11 @@
 //!   measure by how much. So whether a chain runs in lanes (every chain of a joint count does but the last 1
 //!   or 2 after its full groups) changes its motion by rounding, never more; the same inputs always give the
 //!   same bits.
-//! - Chains that may touch a collider run in lanes too: the contact pass stays scalar, one lane at a time,
-//!   between the vector phases of the substep ([`contacts`]). The render pose is computed in lanes as well
+//! - Chains that may touch a collider run in lanes too. Against spheres and capsules, the colliders of a
+//!   character, the contact pass screens every lane's segments at once and takes the scalar test and correction
+//!   only where a segment may touch ([`outside`]); against a ground plane or an inside collider it runs the
+//!   scalar pass one lane at a time ([`contacts`]). Either way a chain's contacts are the scalar solver's, bit
+//!   for bit, given the same positions. The render pose is computed in lanes as well
 //!   ([`output`], the scalar code's operations); everything else a chain does (sleeping, teleports, momentum
 //!   suppression) is shared with the scalar solver.
 
@@ -32,15 +35,19 @@ mod kernel;
 mod lengths;
 mod matching;
 mod output;
+mod outside;
 mod polar;
 mod prefetch;
 mod rotations;
 pub(crate) mod scalar;
+#[cfg(target_arch = "x86_64")]
+mod screen_avx2;
 mod simd;
 mod transpose;
 
 use glam::DVec3;
 use multiversion::multiversion;
+use multiversion::target::match_target;
 
 use super::arena::Arena;
 use super::chain::Chain;
@@ -261,9 +268,29 @@ impl LaneSolver {
     }
 }
 
+/// The screen of 8 lanes in AVX2's vectors ([`screen_avx2`]) where the CPU has it.
+#[allow(clippy::too_many_arguments)]
+#[multiversion(targets("x86_64+avx2"))]
+fn screen8(
+    screen: &outside::Screen<8>,
+    lanes: Mask<8>,
+    start: &[DV3<8>],
+    p: &[DV3<8>],
+    radii: &[F<8>],
+    bounds: &[(DV3<8>, D<8>)],
+    drift: D<8>,
+    slop: F<8>,
+    maybe: &mut [u32],
+) -> u32 {
+    match_target! {
+        "x86_64+avx2" => screen_avx2::screen_all(screen, lanes, start, p, radii, bounds, drift, slop, maybe),
+        _ => outside::screen_all(screen, lanes, start, p, radii, bounds, drift, slop, maybe),
+    }
+}
+
 /// The kernel's phases compiled for `$target` where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $sweep:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $after:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident) => {
+    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $sweep:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $after:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident, $collide:ident, $screen:expr) => {
         #[multiversion(targets($target))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
             kernel::begin_substep(g, s, $predict)
@@ -368,6 +395,11 @@ macro_rules! wide_phases {
             output::write(g, t)
         }
 
+        #[multiversion(targets($target))]
+        fn $collide(g: &mut LaneGroup<$lanes>, lanes: Mask<$lanes>, fresh: bool) -> u64 {
+            contacts::collide(g, lanes, fresh, $screen)
+        }
+
         const $name: Phases<$lanes> = Phases {
             begin: $begin,
             match_shape: $match_shape,
@@ -375,6 +407,7 @@ macro_rules! wide_phases {
             finish: $finish,
             capture: $capture,
             output: $output,
+            collide: $collide,
         };
     };
 }
@@ -396,7 +429,9 @@ wide_phases!(
     predict8,
     spin8,
     capture8,
-    output8
+    output8,
+    collide8,
+    Some(screen8)
 );
 wide_phases!(
     WIDE16,
@@ -416,7 +451,9 @@ wide_phases!(
     predict16,
     spin16,
     capture16,
-    output16
+    output16,
+    collide16,
+    None
 );
 wide_phases!(
     WIDE4,
@@ -435,7 +472,9 @@ wide_phases!(
     predict4,
     spin4,
     capture4,
-    output4
+    output4,
+    collide4,
+    None
 );
 
 /// Steps the chains of `jobs` (at most `L`) in `g`, and asks for those of `next` ([`prefetch`]). Spare lanes

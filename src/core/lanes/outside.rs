@@ -1,0 +1,461 @@
+//! The contact pass of a lane group's chains against spheres and capsules, the colliders of a dressed
+//! character, with the lanes side by side: each segment's quick reject and closest-point test run on every
+//! lane at once, and only a lane whose segment may touch takes `collision`'s scalar test and correction.
+//!
+//! Most pairs past the quick reject touch nothing (86 % of them in the resting hair of
+//! `scene_cost 40 1000x16 colliders`: `docs/performance-history.md`, stop 42). The test that says so, the
+//! screen, is `collision::segment_contact`'s arithmetic written in lanes operation for operation as glam
+//! computes it on one chain (`Quat * Vec3` as [`Turn`]; no fused or reordered operations): here for any width,
+//! and in `screen_avx2` in AVX2's vectors for groups of 8, the only width that takes this pass (the generic
+//! code compiles to two-lane vectors and does not pay: stop 43). So a lane the screen clears is one the scalar
+//! test would clear, each lane still meets its (collider, segment) pairs in the scalar pass's order, and a
+//! chain's bits are those of the scalar contact pass.
+
+use glam::DVec3;
+
+use super::contacts::{extract, write_back};
+use super::group::LaneGroup;
+use super::simd::{D, DV3, F, Mask, Q, V3};
+use crate::core::collider::{ColliderShape, ColliderSweep};
+use crate::core::collision::{self, ContactPass, OutsideCollider, ROOT_LEVER_MIN, SegmentEnds};
+
+/// Whether the lane pass can take `sweep`: a sphere or a capsule that keeps the chain outside.
+pub fn is_outside(sweep: &ColliderSweep) -> bool {
+    matches!(sweep.shape, ColliderShape::Sphere { .. } | ColliderShape::Capsule { .. })
+}
+
+/// Lanes at a collider below which each takes the scalar test on every segment, unscreened.
+const SCREEN_MIN_LANES: usize = 4;
+
+/// `screen_all` compiled for the kernel's instruction set (a phase of `kernel::Phases`).
+pub type ScreenFn<const L: usize> =
+    fn(&Screen<L>, Mask<L>, &[DV3<L>], &[DV3<L>], &[F<L>], &[(DV3<L>, D<L>)], D<L>, F<L>, &mut [u32]) -> u32;
+
+/// One contact pass (`collision::collide`) on the lanes of `lanes`, whose chains can touch only spheres and
+/// capsules. Returns each lane's pass.
+///
+/// For each collider, `screen` tests every segment of every lane at once, with each lane's drift as the
+/// collider's turn begins. Then each lane takes the scalar test on the segments the screen could not clear, in
+/// the scalar pass's order, until its first contact: that moves joints and adds to the drift, so the lane's
+/// later segments take the scalar test (its quick reject first) whatever the screen said.
+#[inline(always)]
+pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: ScreenFn<L>) -> [ContactPass; L] {
+    let n = g.n;
+    let mut passes = [ContactPass::nothing(0); L];
+    let LaneGroup { x, p, contacts, contact_radii, contact_bounds, contact_maybe, lane_x, lane_p, .. } = g;
+    let (x, p, radii, bounds) = (&mut x[..n], &mut p[..n], &contact_radii[..n], &mut contact_bounds[..n - 1]);
+    let maybe = &mut contact_maybe[..n - 1];
+    segment_bounds(x, p, radii, bounds);
+    let slop = F(std::array::from_fn(|lane| contacts[lane].slop));
+    let mut drift = D::<L>::splat(0.0);
+    // Each lane's next candidate; the colliders come in their order, as in the scalar pass.
+    let mut cursor = [0usize; L];
+    loop {
+        let next = lanes_of(lanes).filter_map(|lane| contacts[lane].candidates.get(cursor[lane]).copied()).min();
+        let Some(next) = next else { break };
+        let mut here = Mask([false; L]);
+        let mut first = L;
+        for lane in lanes_of(lanes) {
+            let contact = &contacts[lane];
+            if contact.candidates.get(cursor[lane]) == Some(&next) {
+                here.0[lane] = true;
+                first = first.min(lane);
+                cursor[lane] += 1;
+            }
+        }
+        // Every lane's sweeps of a collider are copies of the same row.
+        let sweep = contacts[first].sweeps[cursor[first] - 1];
+        // With few lanes at this collider, the screen would do the work of all of them for those few.
+        let screened = here.0.iter().filter(|&&set| set).count() >= SCREEN_MIN_LANES;
+        let flagged =
+            if screened { screen(&Screen::new(&sweep), here, x, p, radii, bounds, drift, slop, maybe) } else { 0 };
+        for lane in lanes_of(here) {
+            passes[lane].tested += n as u64 - 1;
+            let contact = &mut contacts[lane];
+            let collider = OutsideCollider::new(&sweep, &contact.input(), DVec3::from_array(p[0].get(lane)));
+            // Segments before `held` join joints the root holds inside (or the root itself).
+            let held = collider.held.joints;
+            let mut exact = !screened;
+            if held > 0 && held < n - 1 {
+                // The held run's last segment: the scalar turn (rare), then the segment's test as any other.
+                let k = held;
+                extract(x, lane, lane_x);
+                extract(p, lane, lane_p);
+                let bound = (DVec3::from_array(bounds[k].0.get(lane)), bounds[k].1.0[lane]);
+                let mut normals = std::mem::take(&mut contact.normals);
+                collision::turn_held(
+                    lane_x,
+                    lane_p,
+                    &sweep,
+                    &contact.input(),
+                    &collider,
+                    bound,
+                    &mut drift.0[lane],
+                    Some(&mut normals),
+                    &mut passes[lane],
+                );
+                contact.normals = normals;
+                write_back(lane_x, lane, x);
+                write_back(lane_p, lane, p);
+                exact = true;
+            } else if screened && flagged & 1 << lane == 0 {
+                continue;
+            }
+            for k in held..n - 1 {
+                if !exact && maybe[k] & 1 << lane == 0 {
+                    continue;
+                }
+                let input = contact.input();
+                let mut ends = SegmentEnds {
+                    start: [x[k].get(lane), x[k + 1].get(lane)].map(DVec3::from_array),
+                    p: [p[k].get(lane), p[k + 1].get(lane)].map(DVec3::from_array),
+                };
+                let bound = (DVec3::from_array(bounds[k].0.get(lane)), bounds[k].1.0[lane]);
+                let Some(found) = collision::segment_contact(k, bound, &ends, &sweep, &input, &collider, drift.0[lane])
+                else {
+                    continue;
+                };
+                drift.0[lane] +=
+                    collision::resolve_segment(k, &found, &sweep, input.friction, &mut ends, &mut passes[lane]);
+                x[k].set(lane, ends.start[0].to_array());
+                x[k + 1].set(lane, ends.start[1].to_array());
+                p[k].set(lane, ends.p[0].to_array());
+                p[k + 1].set(lane, ends.p[1].to_array());
+                exact = true;
+            }
+        }
+    }
+    passes
+}
+
+/// The screen ([`Screen::segment`]) of every segment of the lanes of `lanes` against one collider: `maybe[k]`
+/// gets a bit for each lane whose segment `k` may touch it; returns the lanes with any such segment. `drift` is
+/// each lane's drift (see `collision::collide_outside`). The other lanes' segments are not screened (their
+/// bits stay clear), so they cannot send a segment through the screen's full test.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn screen_all<const L: usize>(
+    screen: &Screen<L>,
+    lanes: Mask<L>,
+    start: &[DV3<L>],
+    p: &[DV3<L>],
+    radii: &[F<L>],
+    bounds: &[(DV3<L>, D<L>)],
+    drift: D<L>,
+    slop: F<L>,
+    maybe: &mut [u32],
+) -> u32 {
+    let mut flagged = 0;
+    for (k, (maybe, &bound)) in maybe.iter_mut().zip(bounds).enumerate() {
+        let lanes = screen.segment(k, lanes, start, p, radii, bound, drift, slop);
+        *maybe = lanes.0.iter().enumerate().fold(0, |bits, (lane, &set)| bits | (set as u32) << lane);
+        flagged |= *maybe;
+    }
+    flagged
+}
+
+/// The lanes set in `mask`, in order (from a bit mask: two branches per lane set, not per lane).
+#[inline(always)]
+fn lanes_of<const L: usize>(mask: Mask<L>) -> impl Iterator<Item = usize> {
+    let mut bits = mask.0.iter().enumerate().fold(0u32, |bits, (lane, &set)| bits | (set as u32) << lane);
+    std::iter::from_fn(move || {
+        (bits != 0).then(|| {
+            let lane = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            lane
+        })
+    })
+}
+
+/// `collision::SegmentBounds::compute` on every lane.
+#[inline(always)]
+fn segment_bounds<const L: usize>(start: &[DV3<L>], p: &[DV3<L>], radii: &[F<L>], bounds: &mut [(DV3<L>, D<L>)]) {
+    let length = |v: DV3<L>| v.length_squared().sqrt();
+    let mut travel_before = length(p[0] - start[0]);
+    for (k, bound) in bounds.iter_mut().enumerate() {
+        let half = length(p[k + 1] - p[k]) * 0.5;
+        let travel_after = length(p[k + 1] - start[k + 1]);
+        let travel = travel_before.zip(travel_after, f64::max);
+        travel_before = travel_after;
+        let thickness = radii[k].zip(radii[k + 1], f32::max).to_f64();
+        *bound = ((p[k] + p[k + 1]) * 0.5, thickness + half + travel);
+    }
+}
+
+/// One collider of the pass, as the vector test needs it: `OutsideCollider` and the sweep's frames.
+pub struct Screen<const L: usize> {
+    pub(super) centre: DV3<L>,
+    pub(super) start_centre: DV3<L>,
+    /// The inverse rotations of the sweep's end and start poses.
+    pub(super) to_end: Turn<L>,
+    pub(super) to_start: Turn<L>,
+    pub(super) solid: f64,
+    pub(super) collider_travel: f64,
+    pub(super) radius: F<L>,
+    pub(super) half_height: F<L>,
+    pub(super) axis: (V3<L>, V3<L>),
+}
+
+impl<const L: usize> Screen<L> {
+    #[inline(always)]
+    fn new(sweep: &ColliderSweep) -> Self {
+        let (radius, half_height) = sweep.shape.capsule().expect("outside colliders are spheres or capsules");
+        let splat = |v: DVec3| DV3 { x: D::splat(v.x), y: D::splat(v.y), z: D::splat(v.z) };
+        let inverse = |q: glam::Quat| {
+            let q = q.inverse();
+            Turn::new(Q { x: F::splat(q.x), y: F::splat(q.y), z: F::splat(q.z), w: F::splat(q.w) })
+        };
+        let axis_end = |y: f32| V3 { x: F::splat(0.0), y: F::splat(y), z: F::splat(0.0) };
+        Self {
+            centre: splat(sweep.end.centre),
+            start_centre: splat(sweep.start.centre),
+            to_end: inverse(sweep.end.rotation),
+            to_start: inverse(sweep.start.rotation),
+            solid: (radius + half_height) as f64,
+            collider_travel: (sweep.end.centre - sweep.start.centre).length(),
+            radius: F::splat(radius),
+            half_height: F::splat(half_height),
+            axis: (axis_end(-half_height), axis_end(half_height)),
+        }
+    }
+
+    /// The lanes whose segment `k` may touch the collider: those that pass the quick reject and whose closest
+    /// point is inside the collider's reach or went through it (`collision::contact_outside`). Every other lane
+    /// is one for which `collision::segment_contact` returns `None`, bit for bit.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn segment(
+        &self,
+        k: usize,
+        lanes: Mask<L>,
+        start: &[DV3<L>],
+        p: &[DV3<L>],
+        radii: &[F<L>],
+        (midpoint, segment_reach): (DV3<L>, D<L>),
+        drift: D<L>,
+        slop: F<L>,
+    ) -> Mask<L> {
+        let clear = D::splat(self.solid) + segment_reach + D::splat(self.collider_travel) + drift * 3.0;
+        let near = (midpoint - self.centre).length_squared().gt(clear * clear).not().and(lanes);
+        if !near.any() {
+            return near;
+        }
+        // The empty barriers split the double-precision steps from the single-precision ones: compiled together,
+        // the lanes went two at a time (the width of a 128-bit vector of doubles) through the whole screen.
+        let (va, vb) = ((p[k] - self.centre).to_f32(), (p[k + 1] - self.centre).to_f32());
+        std::hint::black_box(());
+        let (a, b) = (self.to_end.rotate(va), self.to_end.rotate(vb));
+        let t = closest_on_first((a, b), self.axis);
+        // Next to the kinematic root (segment 0), a contact below `ROOT_LEVER_MIN` moves to the tip.
+        let lever_min = F::splat(if k == 0 { ROOT_LEVER_MIN } else { f32::NEG_INFINITY });
+        let t = F::select(t.lt(lever_min), F::splat(1.0), t);
+        let reach = self.radius + radii[k] + (radii[k + 1] - radii[k]) * t;
+        let point = a.scale(F::splat(1.0) - t) + b.scale(t);
+        std::hint::black_box(());
+        let t64 = t.to_f64();
+        let before = start[k].scale(D::splat(1.0) - t64) + start[k + 1].scale(t64);
+        let before = (before - self.start_centre).to_f32();
+        std::hint::black_box(());
+        let before = self.to_start.rotate(before);
+        // `contact_outside`'s tests.
+        let from_axis = |q: V3<L>| {
+            let on_axis = clamp(q.y, -self.half_height, self.half_height);
+            V3 { x: q.x - F::splat(0.0), y: q.y - on_axis, z: q.z - F::splat(0.0) }
+        };
+        let (from_axis_before, from_axis_now) = (from_axis(before), from_axis(point));
+        let started_outside = from_axis_before.length_squared().sqrt().ge(reach - slop);
+        let went_through = started_outside.and(from_axis_before.dot(from_axis_now).le(F::splat(0.0)));
+        let clear_now = from_axis_now.length_squared().sqrt().ge(reach);
+        near.and(went_through.or(clear_now.not()))
+    }
+}
+
+/// `Q::rotate` by one quaternion on every lane, with what does not depend on the vector computed once: the same
+/// operations on the same numbers, so the same bits.
+pub(super) struct Turn<const L: usize> {
+    pub(super) b: V3<L>,
+    /// `w * w - b.b`
+    pub(super) scale: F<L>,
+    /// `2 w`
+    pub(super) twice_w: F<L>,
+}
+
+impl<const L: usize> Turn<L> {
+    #[inline(always)]
+    fn new(q: Q<L>) -> Self {
+        let b = q.xyz();
+        Self { b, scale: q.w * q.w - b.dot(b), twice_w: q.w * 2.0 }
+    }
+
+    #[inline(always)]
+    fn rotate(&self, v: V3<L>) -> V3<L> {
+        let b = self.b;
+        v.scale(self.scale) + b.scale(v.dot(b) * 2.0) + b.cross(v).scale(self.twice_w)
+    }
+}
+
+/// `f32::clamp` lane by lane (NaN stays NaN).
+#[inline(always)]
+fn clamp<const L: usize>(v: F<L>, min: F<L>, max: F<L>) -> F<L> {
+    let v = F::select(v.lt(min), min, v);
+    F::select(v.gt(max), max, v)
+}
+
+/// `collision::closest_between_segments(p, q).0` lane by lane: every branch computed, the one taken selected.
+#[inline(always)]
+fn closest_on_first<const L: usize>(p: (V3<L>, V3<L>), q: (V3<L>, V3<L>)) -> F<L> {
+    let (zero, one) = (F::splat(0.0), F::splat(1.0));
+    let (d1, d2) = (p.1 - p.0, q.1 - q.0);
+    let r = p.0 - q.0;
+    let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
+    let c = d1.dot(r);
+    let b = d1.dot(d2);
+    let denom = a * e - b * b;
+    let s = F::select(denom.gt(a * 1e-10 * e), clamp((b * f - c * e) / denom, zero, one), zero);
+    let t = (b * s + f) / e;
+    let from_start = clamp(-c / a, zero, one);
+    let s = F::select(t.lt(zero), from_start, F::select(t.gt(one), clamp((b - c) / a, zero, one), s));
+    // The degenerate segments: a point for the first (s = 0), a point for the second (the start's projection).
+    let s = F::select(e.le(zero), from_start, s);
+    F::select(a.le(zero), zero, s)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec3, Quat};
+
+    use super::super::simd::{D, DV3, F, Mask};
+    use super::{Screen, screen_all, segment_bounds};
+    use crate::core::collider::{ColliderPose, ColliderShape, ColliderSweep};
+    use crate::core::collision::{ContactInput, OutsideCollider, SegmentEnds, segment_contact};
+
+    const LANES: usize = 8;
+    const JOINTS: usize = 6;
+
+    /// xorshift64*: the same cases on every run.
+    struct Numbers(u64);
+
+    impl Numbers {
+        fn unit(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        fn between(&mut self, low: f64, high: f64) -> f64 {
+            low + (high - low) * self.unit()
+        }
+
+        fn direction(&mut self) -> DVec3 {
+            loop {
+                let v = DVec3::new(self.between(-1.0, 1.0), self.between(-1.0, 1.0), self.between(-1.0, 1.0));
+                if v.length_squared() > 1e-3 && v.length_squared() <= 1.0 {
+                    return v.normalize();
+                }
+            }
+        }
+
+        fn rotation(&mut self) -> Quat {
+            let axis = self.direction().as_vec3();
+            Quat::from_axis_angle(axis, self.between(0.0, std::f64::consts::TAU) as f32)
+        }
+    }
+
+    /// A sphere or capsule that moves and turns a little during the substep.
+    fn sweep(numbers: &mut Numbers) -> ColliderSweep {
+        let radius = numbers.between(0.04, 0.1) as f32;
+        let shape = if numbers.unit() < 0.5 {
+            ColliderShape::Sphere { radius }
+        } else {
+            ColliderShape::Capsule { radius, half_height: numbers.between(0.02, 0.1) as f32 }
+        };
+        let end = ColliderPose { centre: numbers.direction() * 0.01, rotation: numbers.rotation() };
+        let turn = Quat::from_axis_angle(numbers.direction().as_vec3(), numbers.between(0.0, 0.2) as f32);
+        let start = ColliderPose { centre: end.centre + numbers.direction() * 0.005, rotation: turn * end.rotation };
+        ColliderSweep { shape, start, end }
+    }
+
+    /// Per lane, a chain of `JOINTS` joints (positions at the start of the substep and now), its radii and its
+    /// rest lengths, rooted around the collider.
+    struct Chains {
+        start: Vec<DV3<LANES>>,
+        p: Vec<DV3<LANES>>,
+        radii: Vec<F<LANES>>,
+        lengths: Vec<[f32; LANES]>,
+    }
+
+    fn chains(numbers: &mut Numbers) -> Chains {
+        let mut c = Chains {
+            start: vec![DV3::ZERO; JOINTS],
+            p: vec![DV3::ZERO; JOINTS],
+            radii: vec![F([0.0; LANES]); JOINTS],
+            lengths: vec![[0.0; LANES]; JOINTS - 1],
+        };
+        for lane in 0..LANES {
+            let mut joint = numbers.direction() * numbers.between(0.06, 0.4);
+            for j in 0..JOINTS {
+                if j > 0 {
+                    let length = numbers.between(0.01, 0.05);
+                    joint += numbers.direction() * length;
+                    c.lengths[j - 1][lane] = length as f32;
+                }
+                c.p[j].set(lane, joint.to_array());
+                let moved = if j == 0 { joint } else { joint + numbers.direction() * numbers.between(0.0, 0.03) };
+                c.start[j].set(lane, moved.to_array());
+                c.radii[j].0[lane] = numbers.between(0.0, 0.01) as f32;
+            }
+        }
+        c
+    }
+
+    /// The screen in AVX2 vectors (where the CPU has them) and the generic one flag the same lanes, and a lane
+    /// they clear is one whose scalar test finds no contact.
+    #[test]
+    fn the_screen_clears_only_segments_the_scalar_test_clears() {
+        let mut numbers = Numbers(0x9e37_79b9_7f4a_7c15);
+        let (mut flagged, mut cleared, mut touching) = (0, 0, 0);
+        for _ in 0..400 {
+            let sweep = sweep(&mut numbers);
+            let c = chains(&mut numbers);
+            let mut bounds = vec![(DV3::ZERO, D([0.0; LANES])); JOINTS - 1];
+            segment_bounds(&c.start, &c.p, &c.radii, &mut bounds);
+            let drift = D(std::array::from_fn(|_| if numbers.unit() < 0.5 { 0.0 } else { numbers.between(0.0, 0.05) }));
+            let slop = F([1e-4; LANES]);
+            let screen = Screen::new(&sweep);
+            let all = Mask([true; LANES]);
+            let mut generic = vec![0; JOINTS - 1];
+            let generic_flagged =
+                screen_all(&screen, all, &c.start, &c.p, &c.radii, &bounds, drift, slop, &mut generic);
+            let mut dispatched = vec![u32::MAX; JOINTS - 1];
+            let dispatched_flagged =
+                super::super::screen8(&screen, all, &c.start, &c.p, &c.radii, &bounds, drift, slop, &mut dispatched);
+            assert_eq!((&generic, generic_flagged), (&dispatched, dispatched_flagged), "the vector screens disagree");
+            for lane in 0..LANES {
+                let radii: Vec<f32> = c.radii.iter().map(|r| r.0[lane]).collect();
+                let lengths: Vec<f32> = c.lengths.iter().map(|l| l[lane]).collect();
+                let input =
+                    ContactInput { colliders: &[sweep], radii: &radii, lengths: &lengths, friction: 0.3, slop: 1e-4 };
+                let at = |v: &DV3<LANES>| DVec3::from_array(v.get(lane));
+                let collider = OutsideCollider::new(&sweep, &input, at(&c.p[0]));
+                for k in collider.held.joints..JOINTS - 1 {
+                    let ends = SegmentEnds {
+                        start: [at(&c.start[k]), at(&c.start[k + 1])],
+                        p: [at(&c.p[k]), at(&c.p[k + 1])],
+                    };
+                    let bound = (at(&bounds[k].0), bounds[k].1.0[lane]);
+                    let found = segment_contact(k, bound, &ends, &sweep, &input, &collider, drift.0[lane]);
+                    if generic[k] & 1 << lane != 0 {
+                        flagged += 1;
+                    } else {
+                        cleared += 1;
+                        assert!(found.is_none(), "segment {k} of lane {lane} cleared but touching");
+                    }
+                    touching += found.is_some() as usize;
+                }
+            }
+        }
+        // The cases reach both sides of the screen's decision.
+        assert!(touching > 1000 && cleared > 1000 && flagged > touching, "{flagged} {cleared} {touching}");
+    }
+}

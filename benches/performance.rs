@@ -49,10 +49,11 @@ use scenes::{
 static ALLOCATOR: Counting = Counting;
 
 /// The solver path that ran: the lane solver (the default) with the kernel `kodawari::simd_path` reports for
-/// this CPU (contacts scalar, lane by lane), and the scalar solver for the few left over from the lane groups.
+/// this CPU (how the contact pass runs), and the scalar solver for the few left over from the lane groups.
 fn solver_path() -> String {
-    const NEAR_COLLIDERS: &str = "contacts lane by lane in scalar code; the last 1 or 2 chains of a joint count after \
-                                  its full groups (too few for a group): scalar solver";
+    const NEAR_COLLIDERS: &str = "contacts against spheres and capsules screened in lanes (groups of 8 with AVX2), \
+                                  each contact resolved in scalar code, lane by lane; the last 1 or 2 chains of a \
+                                  joint count after its full groups (too few for a group): scalar solver";
     let lanes = "lane solver (chains of equal joint count in SIMD groups of 16, 8 or 4)";
     match kodawari::simd_path() {
         "avx512" => format!(

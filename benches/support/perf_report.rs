@@ -708,7 +708,8 @@ impl Report {
              settled; *LOD n*: `EngineSettings::lod` (fewer substeps: ns/joint/substep uses the substeps that ran); \
              *scalar solver*: `Engine::set_solver(Solver::Scalar)`, one chain at a time, instead of the default lane \
              solver (equal-length chains side by side in SIMD lanes; the contact pass of chains that may touch a \
-             collider runs lane by lane in scalar code). \
+             collider screens their segments against spheres and capsules in lanes and resolves each contact in \
+             scalar code, lane by lane). \
              Read over 3 frames after each benchmark: heap allocations (a counting allocator), inextensibility \
              solver fallbacks and contact pairs tested (`Stats`), per frame, and the chains the lane solver stepped \
              in the last of them (`Stats::lane_chains`).\n\n\

@@ -51,8 +51,8 @@ pub const KDW_TELEPORT_RESET: u32 = 1;
 
 /// The lane solver (the default): chains of equal joint count are stepped side by side, one chain per SIMD
 /// lane, with the widest kernel copy this CPU has (`kdw_simd_path`); the contact pass of chains that may touch
-/// a collider runs lane by lane in scalar code, and the last 1 or 2 chains of a joint count after its groups
-/// of 16 or 8 (too few for a group to pay) take the scalar solver in a step. It agrees
+/// a collider resolves each contact in scalar code, lane by lane, and the last 1 or 2 chains of a joint count
+/// after its groups of 16 or 8 (too few for a group to pay) take the scalar solver in a step. It agrees
 /// with `KDW_SOLVER_SCALAR` up to float rounding; a chain's bits do not depend on its lane, its group or the
 /// kernel copy.
 pub const KDW_SOLVER_LANES: u32 = 0;

@@ -390,8 +390,8 @@ fn fine_ropes_on_a_collider_match_the_scalar_solver() {
     );
 }
 
-/// Four limp chains (no shape matching) on the lane solver and the same on the scalar solver, driven for
-/// `frames`: every frame, all four in one lane group, the same contact pairs and fallbacks, the same bits.
+/// Four or eight limp chains (no shape matching) on the lane solver and the same on the scalar solver, driven
+/// for `frames`: every frame, all of them in one lane group, the same contact pairs and fallbacks, the same bits.
 fn drive_limp_side_by_side(
     lanes: &mut Engine,
     ids: &[ChainId],
@@ -402,7 +402,7 @@ fn drive_limp_side_by_side(
     for frame in 0..frames {
         drive(lanes, frame..frame + 1);
         drive(scalar, frame..frame + 1);
-        assert_eq!(lanes.stats().lane_chains, 4);
+        assert_eq!(lanes.stats().lane_chains, ids.len() as u32);
         assert_eq!(lanes.stats().contact_pairs_tested, scalar.stats().contact_pairs_tested, "frame {frame}");
         assert_eq!(lanes.stats().solver_fallbacks, scalar.stats().solver_fallbacks, "frame {frame}");
         for (&id, &scalar_id) in ids.iter().zip(scalar_ids) {
@@ -414,15 +414,23 @@ fn drive_limp_side_by_side(
 /// Bug 9's ropes (docs/robustness.md) side by side: roots inside the head sphere's reach, so the contact
 /// rounds turn the joints the roots hold and let the joint past them slide on the sphere
 /// (`inextensible::solve_sliding`), which the lane solver runs lane by lane with the scalar code. Limp ropes
-/// have no shape matching, so both solvers must compute the very same positions and do the same work.
+/// have no shape matching, so both solvers must compute the very same positions and do the same work. Four
+/// ropes make a group of 4 (the contact pass lane by lane); eight a group of 8, whose contact pass screens the
+/// segments in lanes where the CPU has AVX2 (`lanes::outside`).
 #[test]
 fn ropes_rooted_inside_a_collider_match_the_scalar_solver() {
+    for ropes in [4, 8] {
+        ropes_rooted_inside_a_collider(ropes);
+    }
+}
+
+fn ropes_rooted_inside_a_collider(ropes: usize) {
     let build_rooted = |solver: Solver| {
         let mut engine = Engine::new(EngineSettings::default()).unwrap();
         engine.set_solver(solver);
         let radius = 0.02;
         let mut ids = Vec::new();
-        for i in 0..4 {
+        for i in 0..ropes {
             let around = i as f32 * 0.4 - 0.6;
             let out = Vec3::new(around.cos(), 0.0, around.sin());
             // 9 mm inside the reach with 4 mm segments: the first joints are held (`collision::held_by_root`).
@@ -445,8 +453,8 @@ fn ropes_rooted_inside_a_collider_match_the_scalar_solver() {
         .map(|joint| HEAD_RADIUS + 0.02 - (joint.position - head_pose.position).length())
         .fold(f32::NEG_INFINITY, f32::max);
     println!(
-        "ropes rooted inside the head sphere's reach, 0.5 s: the same bits on both solvers, {} contact pairs, \
-         {} fallbacks; deepest joint past the held ones {deepest:.1e} m inside the sphere's reach",
+        "{ropes} ropes rooted inside the head sphere's reach, 0.5 s: the same bits on both solvers, {} contact \
+         pairs, {} fallbacks; deepest joint past the held ones {deepest:.1e} m inside the sphere's reach",
         lanes.stats().contact_pairs_tested,
         lanes.stats().solver_fallbacks
     );

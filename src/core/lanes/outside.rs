@@ -438,7 +438,9 @@ mod tests {
                     ContactInput { colliders: &[sweep], radii: &radii, lengths: &lengths, friction: 0.3, slop: 1e-4 };
                 let at = |v: &DV3<LANES>| DVec3::from_array(v.get(lane));
                 let collider = OutsideCollider::new(&sweep, &input, at(&c.p[0]));
-                for k in collider.held.joints..JOINTS - 1 {
+                // The segment leaving held joints always takes the scalar test (`collide`), screened or not.
+                let first = collider.held.joints + (collider.held.joints > 0) as usize;
+                for k in first..JOINTS - 1 {
                     let ends = SegmentEnds {
                         start: [at(&c.start[k]), at(&c.start[k + 1])],
                         p: [at(&c.p[k]), at(&c.p[k + 1])],
@@ -456,6 +458,6 @@ mod tests {
             }
         }
         // The cases reach both sides of the screen's decision.
-        assert!(touching > 1000 && cleared > 1000 && flagged > touching, "{flagged} {cleared} {touching}");
+        assert!(touching > 1000 && cleared > 1000 && flagged >= touching, "{flagged} {cleared} {touching}");
     }
 }

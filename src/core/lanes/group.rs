@@ -117,7 +117,7 @@ pub struct LaneGroup<const L: usize> {
     /// quick-reject bound.
     pub(super) contact_radii: Vec<F<L>>,
     pub(super) contact_bounds: Vec<(DV3<L>, D<L>)>,
-    /// Per segment, the lanes whose segment may touch the collider at hand (`outside::screen_all`).
+    /// Per segment, the lanes whose segment may touch the collider at hand (`outside::ScreenFn`).
     pub(super) contact_maybe: Vec<u32>,
 }
 

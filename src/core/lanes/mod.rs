@@ -284,7 +284,10 @@ fn screen8(
 ) -> u32 {
     match_target! {
         "x86_64+avx2" => screen_avx2::screen_all(screen, lanes, start, p, radii, bounds, drift, slop, maybe),
-        _ => outside::screen_all(screen, lanes, start, p, radii, bounds, drift, slop, maybe),
+        _ => {
+            let _ = (screen, start, p, radii, bounds, drift, slop);
+            outside::flag_all(lanes, maybe)
+        }
     }
 }
 

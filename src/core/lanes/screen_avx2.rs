@@ -1,7 +1,8 @@
-//! `outside::Screen::segment` for groups of 8 lanes, in AVX2's 256-bit vectors: 8 singles or 4 doubles to a
-//! register. The generic code, compiled for AVX2, ran the screen two lanes at a time (the width of a 128-bit
-//! vector of doubles; `docs/performance-history.md`, stop 43). The same operations on the same numbers in the
-//! same order, so the same bits: `tests` compares the two on random segments.
+//! The contact pass's screen (`outside::ScreenFn`) for groups of 8 lanes, in AVX2's 256-bit vectors: 8 singles or
+//! 4 doubles to a register. It computes `collision::segment_contact`'s quick reject, closest point and
+//! `contact_outside` tests with glam's operations in glam's order, so a segment it clears is one the scalar test
+//! clears (`outside`'s test checks it on random segments). Written in the crate's generic lane types, the
+//! same screen compiled to two-lane vectors (`docs/performance-history.md`, stop 43).
 
 use std::arch::x86_64::*;
 
@@ -45,7 +46,7 @@ fn dv8(v: &DV3<8>) -> DV8 {
     DV8 { x: d8(&v.x), y: d8(&v.y), z: d8(&v.z) }
 }
 
-/// The screen of every segment against one collider (see `outside::screen_all`).
+/// The screen of every segment against one collider (see `outside::ScreenFn`).
 #[allow(clippy::too_many_arguments)]
 #[target_feature(enable = "avx2")]
 pub fn screen_all(
@@ -119,7 +120,7 @@ impl Turn8 {
         Self { b: v8(&turn.b), scale: f8(&turn.scale), twice_w: f8(&turn.twice_w) }
     }
 
-    /// `Turn::rotate`.
+    /// glam's `Quat * Vec3` by `outside::Turn`'s quaternion.
     #[inline]
     #[target_feature(enable = "avx2")]
     fn rotate(&self, v: V8) -> V8 {
@@ -208,7 +209,7 @@ fn clamp(v: __m256, min: __m256, max: __m256) -> __m256 {
     select(_mm256_cmp_ps::<_CMP_GT_OQ>(v, max), max, v)
 }
 
-/// `outside::closest_on_first`.
+/// `collision::closest_between_segments(p, q).0`, every branch computed and the one taken selected.
 #[inline]
 #[target_feature(enable = "avx2")]
 fn closest_on_first(p: (V8, V8), q: (V8, V8)) -> __m256 {
@@ -235,7 +236,8 @@ fn closest_on_first(p: (V8, V8), q: (V8, V8)) -> __m256 {
     select(_mm256_cmp_ps::<_CMP_LE_OQ>(a, zero), zero, s)
 }
 
-/// `Screen::segment`, as a bit per lane.
+/// The screen of segment `k` of the lanes in `lanes` (a bit per lane): those past the quick reject whose closest
+/// point is inside the reach or went through it (`collision::contact_outside`).
 #[inline]
 #[target_feature(enable = "avx2")]
 fn segment(

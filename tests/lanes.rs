@@ -496,3 +496,68 @@ fn hair_ropes_that_keep_falling_back_match_the_scalar_solver() {
     // Most substeps fall back, so streaks of two and more run (and skip the direct solve).
     assert!(fallbacks * 10 >= chain_substeps * 6, "{fallbacks} of {chain_substeps}");
 }
+
+/// A ball created where eight limp ropes hang, deep inside it (a collider created on the chains): the substep
+/// starts with pre-stabilisation's rounds of lengths and contacts at the start positions
+/// (`collision::pre_stabilise`), whose first contact pass the lane solver runs in lanes for a group of 8 where
+/// the CPU has AVX2 (`lanes::outside::pre_stabilise`), the rounds lane by lane. Limp ropes have no shape
+/// matching, so both solvers must compute the very same positions and do the same work, frame by frame.
+#[test]
+fn ropes_a_ball_appears_around_match_the_scalar_solver() {
+    const BALL_RADIUS: f32 = 0.16;
+    let ball_centre = head(0).position - Vec3::new(0.0, 0.25, 0.0);
+    let build = |solver: Solver| {
+        let mut engine = Engine::new(EngineSettings::default()).unwrap();
+        engine.set_solver(solver);
+        let ids: Vec<ChainId> = (0..8)
+            .map(|i| {
+                let around = i as f32 * 0.785;
+                let out = Vec3::new(around.cos(), 0.0, around.sin());
+                let base = straight_chain(16, out * (HEAD_RADIUS + 0.03), out * 0.2 - Vec3::Y, 0.02);
+                let params = ChainParams { stiffness: 0.0, radius: 0.01, damping: 2.0, ..Default::default() };
+                engine.create_chain(params, &base).unwrap()
+            })
+            .collect();
+        add_colliders(&mut engine);
+        (engine, ids)
+    };
+    let (mut lanes, ids) = build(Solver::Lanes);
+    let (mut scalar, scalar_ids) = build(Solver::Scalar);
+    let inside_ball = |engine: &Engine| {
+        let joints = ids.iter().flat_map(|&id| chain_world(engine, id));
+        let depths: Vec<f32> =
+            joints.map(|joint| BALL_RADIUS + 0.01 - (joint.position - ball_centre).length()).collect();
+        (depths.iter().filter(|&&depth| depth > 0.0).count(), depths.into_iter().fold(f32::NEG_INFINITY, f32::max))
+    };
+    drive_limp_side_by_side(&mut lanes, &ids, &mut scalar, &scalar_ids, 10);
+    let (joints_inside, deepest_before) = inside_ball(&lanes);
+    let ball = ColliderDef {
+        shape: ColliderShape::Sphere { radius: BALL_RADIUS },
+        transform: Transform::new(ball_centre, Quat::IDENTITY),
+        layers: 1,
+    };
+    for engine in [&mut lanes, &mut scalar] {
+        engine.create_collider(&ball).unwrap();
+    }
+    for frame in 10..20 {
+        for engine in [&mut lanes, &mut scalar] {
+            let [head_pose, shoulder_pose] = colliders(&head(frame));
+            let ball_pose = Transform::new(ball_centre, Quat::IDENTITY);
+            engine.set_collider_transforms([head_pose, shoulder_pose, ball_pose].into_iter()).unwrap();
+            engine.step(1.0 / 60.0, orbit_camera(HEAD, 3.0, frame as f32 * 0.05), head(frame)).unwrap();
+        }
+        assert_eq!(lanes.stats().lane_chains, 8);
+        assert_eq!(lanes.stats().contact_pairs_tested, scalar.stats().contact_pairs_tested, "frame {frame}");
+        assert_eq!(lanes.stats().solver_fallbacks, scalar.stats().solver_fallbacks, "frame {frame}");
+        for (&id, &scalar_id) in ids.iter().zip(&scalar_ids) {
+            assert_eq!(particle_bits(&lanes, id), particle_bits(&scalar, scalar_id), "frame {frame}");
+        }
+    }
+    let (_, deepest_after) = inside_ball(&lanes);
+    println!(
+        "a ball created around 8 limp ropes: {joints_inside} joints up to {deepest_before:.3} m inside its reach; \
+         10 frames later the deepest {deepest_after:.1e} m; the same bits on both solvers"
+    );
+    assert!(joints_inside >= 8 && deepest_before > 0.02, "{joints_inside} joints, {deepest_before} m");
+    assert!(deepest_after <= 1e-3, "{deepest_after}");
+}

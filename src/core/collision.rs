@@ -96,7 +96,7 @@ impl SegmentBounds {
 
 /// Which of a sweep's poses the contacts are resolved against.
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum Pose {
+pub(crate) enum Pose {
     /// The end of the substep: the normal case.
     End,
     /// The start: pre-stabilisation of the positions the substep starts from.
@@ -114,24 +114,38 @@ pub fn pre_stabilise(
     scratch: &mut [DVec3],
     input: &ContactInput<'_>,
     rounds: u32,
-    mut keep_lengths: impl FnMut(&[DVec3], &mut [DVec3]),
+    keep_lengths: impl FnMut(&[DVec3], &mut [DVec3]),
     settled: f32,
     bounds: &mut SegmentBounds,
 ) -> bool {
     scratch.copy_from_slice(x);
-    let mut pass = collide_at(scratch, x, input, Pose::Start, bounds, None);
+    let pass = collide_at(scratch, x, input, Pose::Start, bounds, None);
     // Joints left on a surface by the last substep touch it within rounding: only a real overlap needs rounds.
     if pass.deepest <= settled {
         return false;
     }
+    pre_stabilise_rounds(x, scratch, input, rounds, keep_lengths, settled, bounds);
+    true
+}
+
+/// The rounds of [`pre_stabilise`] after its first contact pass found an overlap deeper than `settled`
+/// (`scratch` as that pass left it): lengths, then contacts, until they settle.
+pub fn pre_stabilise_rounds(
+    x: &mut [DVec3],
+    scratch: &mut [DVec3],
+    input: &ContactInput<'_>,
+    rounds: u32,
+    mut keep_lengths: impl FnMut(&[DVec3], &mut [DVec3]),
+    settled: f32,
+    bounds: &mut SegmentBounds,
+) {
     for _ in 1..rounds {
         keep_lengths(scratch, x);
-        pass = collide_at(scratch, x, input, Pose::Start, bounds, None);
+        let pass = collide_at(scratch, x, input, Pose::Start, bounds, None);
         if pass.deepest <= settled {
             break;
         }
     }
-    true
 }
 
 fn collide_at(
@@ -171,7 +185,7 @@ fn collide_at(
     result
 }
 
-fn at(sweep: &ColliderSweep, pose: Pose) -> ColliderSweep {
+pub(crate) fn at(sweep: &ColliderSweep, pose: Pose) -> ColliderSweep {
     match pose {
         Pose::End => *sweep,
         Pose::Start => ColliderSweep { end: sweep.start, ..*sweep },

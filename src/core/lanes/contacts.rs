@@ -77,15 +77,68 @@ impl LaneContacts {
 }
 
 /// Pre-stabilisation (`collision::pre_stabilise`) of the start positions of the lanes in `lanes` (not those
-/// that start clear: see `LaneContacts::starts_clear`).
-pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) {
+/// that start clear: see `LaneContacts::starts_clear`). With a screen, the first contact pass of the lanes whose
+/// chains can touch only spheres and capsules runs in lanes ([`outside::pre_stabilise`]); the rare lanes it
+/// finds deeper inside than their settled distance take the rounds that follow, and the other lanes the whole
+/// of it, in `collision`'s scalar code one lane at a time.
+#[inline(always)]
+pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: Option<ScreenFn<L>>) {
     let n = g.n;
+    let mut in_lanes = Mask([false; L]);
+    let mut scalar = Mask([false; L]);
     for lane in (0..L).filter(|&lane| lanes.0[lane]) {
-        // A lane that starts clear is skipped; debug builds pre-stabilise it anyway and check that nothing moves.
-        let skip = g.contacts[lane].starts_clear;
-        if skip && !cfg!(debug_assertions) {
-            continue;
+        let contact = &g.contacts[lane];
+        // A lane that starts clear is skipped; debug builds pre-stabilise it anyway (scalar, below) and check
+        // that nothing moves.
+        if contact.starts_clear {
+            scalar.0[lane] = cfg!(debug_assertions);
+        } else if screen.is_some() && contact.sweeps.iter().all(outside::is_outside) {
+            in_lanes.0[lane] = true;
+        } else {
+            scalar.0[lane] = true;
         }
+    }
+    if let Some(screen) = screen.filter(|_| in_lanes.any()) {
+        let passes = outside::pre_stabilise(g, in_lanes, screen);
+        for lane in (0..L).filter(|&lane| in_lanes.0[lane]) {
+            // Joints left on a surface by the last substep touch it within rounding: only a real overlap needs
+            // rounds.
+            if passes[lane].deepest <= g.contacts[lane].settled {
+                continue;
+            }
+            let LaneGroup {
+                x,
+                contact_start,
+                lengths,
+                lane_x,
+                lane_scratch,
+                lane_lengths,
+                contacts,
+                constraints,
+                segment_bounds,
+                ..
+            } = g;
+            extract(&x[..n], lane, lane_x);
+            extract(&contact_start[..n], lane, lane_scratch);
+            lane_lengths.clear();
+            lane_lengths.extend(lengths[..n - 1].iter().map(|l| l.0[lane]));
+            let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
+                inextensible::solve(previous, x, lane_lengths, constraints);
+            };
+            let contact = &contacts[lane];
+            collision::pre_stabilise_rounds(
+                lane_x,
+                lane_scratch,
+                &contact.input(),
+                FINAL_CONTACT_ROUNDS,
+                keep_lengths,
+                contact.settled,
+                segment_bounds,
+            );
+            write_back(lane_x, lane, &mut x[..n]);
+        }
+    }
+    for lane in (0..L).filter(|&lane| scalar.0[lane]) {
         let LaneGroup { x, lengths, lane_x, lane_scratch, lane_lengths, contacts, constraints, segment_bounds, .. } = g;
         extract(&x[..n], lane, lane_x);
         lane_lengths.clear();
@@ -104,7 +157,7 @@ pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>) {
             contact.settled,
             segment_bounds,
         );
-        if skip {
+        if contact.starts_clear {
             extract(&x[..n], lane, lane_scratch);
             debug_assert!(
                 crate::core::rod::same_bits(lane_x, lane_scratch),

@@ -32,6 +32,8 @@ pub struct Phases<const L: usize> {
     pub output: fn(&mut LaneGroup<L>, f32),
     /// One contact pass on some lanes ([`contacts::collide`]); returns the pairs tested.
     pub collide: fn(&mut LaneGroup<L>, Mask<L>, bool) -> u64,
+    /// Pre-stabilisation of some lanes ([`contacts::pre_stabilise`]).
+    pub pre_stabilise: fn(&mut LaneGroup<L>, Mask<L>),
 }
 
 impl<const L: usize> Phases<L> {
@@ -44,6 +46,7 @@ impl<const L: usize> Phases<L> {
         capture: output::capture,
         output: output::write,
         collide: |g, lanes, fresh| contacts::collide(g, lanes, fresh, None),
+        pre_stabilise: |g, lanes| contacts::pre_stabilise(g, lanes, None),
     };
 }
 
@@ -66,7 +69,7 @@ pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, phases: &Phases<L
 /// pairs tested.
 pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, phases: &Phases<L>) -> (Mask<L>, u64) {
     let touching = g.contact_lanes;
-    contacts::pre_stabilise(g, touching);
+    (phases.pre_stabilise)(g, touching);
     (phases.begin)(g, s);
     let iterations = iterations(g);
     let mut fell_back = Mask([false; L]);

@@ -293,7 +293,7 @@ fn screen8(
 
 /// The kernel's phases compiled for `$target` where the CPU has it, one dispatching function per phase and width.
 macro_rules! wide_phases {
-    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $sweep:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $after:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident, $collide:ident, $screen:expr) => {
+    ($name:ident, $lanes:literal, $target:literal, $begin:ident, $match_shape:ident, $sweep:ident, $terms:ident, $solve:ident, $passes:ident, $first:ident, $corrected:ident, $after:ident, $finish:ident, $predict:ident, $spin:ident, $capture:ident, $output:ident, $collide:ident, $pre_stabilise:ident, $screen:expr) => {
         #[multiversion(targets($target))]
         fn $begin(g: &mut LaneGroup<$lanes>, s: usize) {
             kernel::begin_substep(g, s, $predict)
@@ -403,6 +403,11 @@ macro_rules! wide_phases {
             contacts::collide(g, lanes, fresh, $screen)
         }
 
+        #[multiversion(targets($target))]
+        fn $pre_stabilise(g: &mut LaneGroup<$lanes>, lanes: Mask<$lanes>) {
+            contacts::pre_stabilise(g, lanes, $screen)
+        }
+
         const $name: Phases<$lanes> = Phases {
             begin: $begin,
             match_shape: $match_shape,
@@ -411,6 +416,7 @@ macro_rules! wide_phases {
             capture: $capture,
             output: $output,
             collide: $collide,
+            pre_stabilise: $pre_stabilise,
         };
     };
 }
@@ -434,6 +440,7 @@ wide_phases!(
     capture8,
     output8,
     collide8,
+    pre_stabilise8,
     Some(screen8)
 );
 wide_phases!(
@@ -456,6 +463,7 @@ wide_phases!(
     capture16,
     output16,
     collide16,
+    pre_stabilise16,
     None
 );
 wide_phases!(
@@ -477,6 +485,7 @@ wide_phases!(
     capture4,
     output4,
     collide4,
+    pre_stabilise4,
     None
 );
 

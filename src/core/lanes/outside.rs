@@ -13,11 +13,11 @@
 
 use glam::DVec3;
 
-use super::contacts::{extract, write_back};
+use super::contacts::{LaneContacts, extract, write_back};
 use super::group::LaneGroup;
 use super::simd::{D, DV3, F, Mask, Q, V3};
 use crate::core::collider::{ColliderShape, ColliderSweep};
-use crate::core::collision::{self, ContactPass, OutsideCollider, SegmentEnds};
+use crate::core::collision::{self, ContactPass, OutsideCollider, Pose, SegmentEnds};
 
 /// Whether the lane pass can take `sweep`: a sphere or a capsule that keeps the chain outside.
 pub fn is_outside(sweep: &ColliderSweep) -> bool {
@@ -35,18 +35,59 @@ pub type ScreenFn<const L: usize> =
 
 /// One contact pass (`collision::collide`) on the lanes of `lanes`, whose chains can touch only spheres and
 /// capsules. Returns each lane's pass.
+#[inline(always)]
+pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: ScreenFn<L>) -> [ContactPass; L] {
+    let n = g.n;
+    let LaneGroup { x, p, contacts, contact_radii, contact_bounds, contact_maybe, lane_x, lane_p, .. } = g;
+    let scratch = Scratch { radii: contact_radii, bounds: contact_bounds, maybe: contact_maybe, lane_x, lane_p };
+    pass(&mut x[..n], &mut p[..n], contacts, scratch, lanes, screen, Pose::End)
+}
+
+/// The first contact pass of pre-stabilisation (`collision::pre_stabilise`) on the lanes of `lanes`, whose chains
+/// can touch only spheres and capsules: the start positions against the colliders at their start pose, from a
+/// copy of them (`LaneGroup::contact_start`, which keeps what the pass did to it for the rounds that may follow).
+/// Returns each lane's pass.
+#[inline(always)]
+pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: ScreenFn<L>) -> [ContactPass; L] {
+    let n = g.n;
+    let LaneGroup { x, contact_start, contacts, contact_radii, contact_bounds, contact_maybe, lane_x, lane_p, .. } = g;
+    contact_start[..n].copy_from_slice(&x[..n]);
+    let scratch = Scratch { radii: contact_radii, bounds: contact_bounds, maybe: contact_maybe, lane_x, lane_p };
+    pass(&mut contact_start[..n], &mut x[..n], contacts, scratch, lanes, screen, Pose::Start)
+}
+
+/// The group's buffers a pass works in besides the positions.
+struct Scratch<'g, const L: usize> {
+    radii: &'g [F<L>],
+    bounds: &'g mut [(DV3<L>, D<L>)],
+    maybe: &'g mut [u32],
+    lane_x: &'g mut Vec<DVec3>,
+    lane_p: &'g mut Vec<DVec3>,
+}
+
+/// A contact pass of the lanes of `lanes` moving `p` (and `start`, where a joint was inside at the start),
+/// against the colliders at their `pose`: `collision::collide_at`'s outside passes, lane by lane, bit for bit.
 ///
 /// For each collider, `screen` tests every segment of every lane at once, with each lane's drift as the
 /// collider's turn begins. Then each lane takes the scalar test on the segments the screen could not clear, in
 /// the scalar pass's order, until its first contact: that moves joints and adds to the drift, so the lane's
-/// later segments take the scalar test (its quick reject first) whatever the screen said.
+/// later segments take the scalar test (its quick reject first) whatever the screen said. The normals of
+/// sliding joints are kept at the end pose only (pre-stabilisation has none).
 #[inline(always)]
-pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: ScreenFn<L>) -> [ContactPass; L] {
-    let n = g.n;
+fn pass<const L: usize>(
+    start: &mut [DV3<L>],
+    p: &mut [DV3<L>],
+    contacts: &mut [LaneContacts],
+    scratch: Scratch<'_, L>,
+    lanes: Mask<L>,
+    screen: ScreenFn<L>,
+    pose: Pose,
+) -> [ContactPass; L] {
+    let n = p.len();
     let mut passes = [ContactPass::nothing(0); L];
-    let LaneGroup { x, p, contacts, contact_radii, contact_bounds, contact_maybe, lane_x, lane_p, .. } = g;
-    let (x, p, radii, bounds) = (&mut x[..n], &mut p[..n], &contact_radii[..n], &mut contact_bounds[..n - 1]);
-    let maybe = &mut contact_maybe[..n - 1];
+    let x = start;
+    let Scratch { radii, bounds, maybe, lane_x, lane_p } = scratch;
+    let (radii, bounds, maybe) = (&radii[..n], &mut bounds[..n - 1], &mut maybe[..n - 1]);
     segment_bounds(x, p, radii, bounds);
     let slop = F(std::array::from_fn(|lane| contacts[lane].slop));
     let mut drift = D::<L>::splat(0.0);
@@ -66,7 +107,7 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: Scr
             }
         }
         // Every lane's sweeps of a collider are copies of the same row.
-        let sweep = contacts[first].sweeps[cursor[first] - 1];
+        let sweep = collision::at(&contacts[first].sweeps[cursor[first] - 1], pose);
         // With few lanes at this collider, the screen would do the work of all of them for those few.
         let screened = here.0.iter().filter(|&&set| set).count() >= SCREEN_MIN_LANES;
         let flagged =
@@ -93,7 +134,7 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: Scr
                     &collider,
                     bound,
                     &mut drift.0[lane],
-                    Some(&mut normals),
+                    (pose == Pose::End).then_some(&mut normals[..]),
                     &mut passes[lane],
                 );
                 contact.normals = normals;

@@ -117,8 +117,6 @@ pub struct LaneGroup<const L: usize> {
     /// quick-reject bound.
     pub(super) contact_radii: Vec<F<L>>,
     pub(super) contact_bounds: Vec<(DV3<L>, D<L>)>,
-    /// Per segment, the lanes whose segment may touch the collider at hand (`outside::ScreenFn`).
-    pub(super) contact_maybe: Vec<u32>,
     /// Pre-stabilisation's copy of the start positions (`outside::pre_stabilise`).
     pub(super) contact_start: Vec<DV3<L>>,
 }
@@ -241,7 +239,6 @@ impl<const L: usize> LaneGroup<L> {
         self.segment_bounds.reserve(n);
         fit(&mut self.contact_radii, n, F([0.0; L]));
         fit(&mut self.contact_bounds, n, (DV3::ZERO, D([0.0; L])));
-        fit(&mut self.contact_maybe, n, 0);
         fit(&mut self.contact_start, n, DV3::ZERO);
     }
 

@@ -274,19 +274,19 @@ impl LaneSolver {
 fn screen8(
     screen: &outside::Screen<8>,
     lanes: Mask<8>,
-    start: &[DV3<8>],
-    p: &[DV3<8>],
+    start: &mut [DV3<8>],
+    p: &mut [DV3<8>],
     radii: &[F<8>],
     bounds: &[(DV3<8>, D<8>)],
-    drift: D<8>,
+    drift: &mut D<8>,
     slop: F<8>,
-    maybe: &mut [u32],
-) -> u32 {
+    resolve: &mut outside::Resolve<'_, 8>,
+) {
     match_target! {
-        "x86_64+avx2" => screen_avx2::screen_all(screen, lanes, start, p, radii, bounds, drift, slop, maybe),
+        "x86_64+avx2" => screen_avx2::screen_all(screen, lanes, start, p, radii, bounds, drift, slop, resolve),
         _ => {
-            let _ = (screen, start, p, radii, bounds, drift, slop);
-            outside::flag_all(lanes, maybe)
+            let _ = (screen, radii, slop);
+            outside::every_segment(lanes, start, p, bounds.len(), drift, resolve)
         }
     }
 }

@@ -7,9 +7,12 @@
 //! screen, is `collision::segment_contact`'s arithmetic written in lanes operation for operation as glam
 //! computes it on one chain (`Quat * Vec3` as [`Turn`]; no fused or reordered operations), in AVX2's vectors
 //! (`screen_avx2`) for groups of 8, the only width that takes this pass (written in the generic lane types, it
-//! compiled to two-lane vectors and did not pay: stop 43). So a lane the screen clears is one the scalar
-//! test would clear, each lane still meets its (collider, segment) pairs in the scalar pass's order, and a
-//! chain's bits are those of the scalar contact pass.
+//! compiled to two-lane vectors and did not pay: stop 43). The screen takes a collider's segments one after
+//! another, each with the positions and drift the segments before left (stop 44; until then it screened every
+//! segment up front, and after a lane's first contact all its later segments took the scalar test). So a lane
+//! the screen clears is one the scalar test would clear, each lane still meets its (collider, segment) pairs in
+//! the scalar pass's order, and a chain's bits are those of the scalar contact pass. Pre-stabilisation's first
+//! pass ([`pre_stabilise`]) runs the same way, at the colliders' start pose.
 
 use glam::DVec3;
 
@@ -27,19 +30,33 @@ pub fn is_outside(sweep: &ColliderSweep) -> bool {
 /// Lanes at a collider below which each takes the scalar test on every segment, unscreened.
 const SCREEN_MIN_LANES: usize = 4;
 
-/// The screen of every segment of the lanes of a mask against one collider (`screen_avx2::screen_all`, where the
-/// CPU has AVX2; [`flag_all`] elsewhere): sets a bit in `maybe[k]` for each lane whose segment `k` may touch it,
-/// and returns the lanes with any such segment.
-pub type ScreenFn<const L: usize> =
-    fn(&Screen<L>, Mask<L>, &[DV3<L>], &[DV3<L>], &[F<L>], &[(DV3<L>, D<L>)], D<L>, F<L>, &mut [u32]) -> u32;
+/// The screen of the lanes of a mask against one collider (`screen_avx2::screen_all`, where the CPU has AVX2;
+/// [`every_segment`] elsewhere): segment after segment, in the scalar pass's order, it tests each lane's segment
+/// with the lane's positions and drift as they are then, and calls [`Resolve`] with the lanes whose segment may
+/// touch.
+pub type ScreenFn<const L: usize> = fn(
+    &Screen<L>,
+    Mask<L>,
+    &mut [DV3<L>],
+    &mut [DV3<L>],
+    &[F<L>],
+    &[(DV3<L>, D<L>)],
+    &mut D<L>,
+    F<L>,
+    &mut Resolve<'_, L>,
+);
+
+/// The scalar test and correction of segment `k` of the lanes set in a bit mask, which may touch the collider:
+/// moves their joints (start positions and positions) and adds to their drift.
+pub type Resolve<'a, const L: usize> = dyn FnMut(usize, u32, &mut [DV3<L>], &mut [DV3<L>], &mut D<L>) + 'a;
 
 /// One contact pass (`collision::collide`) on the lanes of `lanes`, whose chains can touch only spheres and
 /// capsules. Returns each lane's pass.
 #[inline(always)]
 pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: ScreenFn<L>) -> [ContactPass; L] {
     let n = g.n;
-    let LaneGroup { x, p, contacts, contact_radii, contact_bounds, contact_maybe, lane_x, lane_p, .. } = g;
-    let scratch = Scratch { radii: contact_radii, bounds: contact_bounds, maybe: contact_maybe, lane_x, lane_p };
+    let LaneGroup { x, p, contacts, contact_radii, contact_bounds, lane_x, lane_p, .. } = g;
+    let scratch = Scratch { radii: contact_radii, bounds: contact_bounds, lane_x, lane_p };
     pass(&mut x[..n], &mut p[..n], contacts, scratch, lanes, screen, Pose::End)
 }
 
@@ -50,9 +67,9 @@ pub fn collide<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: Scr
 #[inline(always)]
 pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: ScreenFn<L>) -> [ContactPass; L] {
     let n = g.n;
-    let LaneGroup { x, contact_start, contacts, contact_radii, contact_bounds, contact_maybe, lane_x, lane_p, .. } = g;
+    let LaneGroup { x, contact_start, contacts, contact_radii, contact_bounds, lane_x, lane_p, .. } = g;
     contact_start[..n].copy_from_slice(&x[..n]);
-    let scratch = Scratch { radii: contact_radii, bounds: contact_bounds, maybe: contact_maybe, lane_x, lane_p };
+    let scratch = Scratch { radii: contact_radii, bounds: contact_bounds, lane_x, lane_p };
     pass(&mut contact_start[..n], &mut x[..n], contacts, scratch, lanes, screen, Pose::Start)
 }
 
@@ -60,7 +77,6 @@ pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, scree
 struct Scratch<'g, const L: usize> {
     radii: &'g [F<L>],
     bounds: &'g mut [(DV3<L>, D<L>)],
-    maybe: &'g mut [u32],
     lane_x: &'g mut Vec<DVec3>,
     lane_p: &'g mut Vec<DVec3>,
 }
@@ -68,11 +84,12 @@ struct Scratch<'g, const L: usize> {
 /// A contact pass of the lanes of `lanes` moving `p` (and `start`, where a joint was inside at the start),
 /// against the colliders at their `pose`: `collision::collide_at`'s outside passes, lane by lane, bit for bit.
 ///
-/// For each collider, `screen` tests every segment of every lane at once, with each lane's drift as the
-/// collider's turn begins. Then each lane takes the scalar test on the segments the screen could not clear, in
-/// the scalar pass's order, until its first contact: that moves joints and adds to the drift, so the lane's
-/// later segments take the scalar test (its quick reject first) whatever the screen said. The normals of
-/// sliding joints are kept at the end pose only (pre-stabilisation has none).
+/// The colliders come in their order. For each, `screen` takes the segments one after another, testing every
+/// lane's at once with its positions and drift as the segments before left them, and only a lane whose segment
+/// it cannot clear takes the scalar test and correction: so each lane meets its (collider, segment) pairs in the
+/// scalar pass's order, with the scalar pass's inputs. A lane whose root holds joints inside the collider (bug
+/// 9) takes the scalar turn and tests instead, as does every lane at a collider with few lanes at it. The normals
+/// of sliding joints are kept at the end pose only (pre-stabilisation has none).
 #[inline(always)]
 fn pass<const L: usize>(
     start: &mut [DV3<L>],
@@ -86,9 +103,10 @@ fn pass<const L: usize>(
     let n = p.len();
     let mut passes = [ContactPass::nothing(0); L];
     let x = start;
-    let Scratch { radii, bounds, maybe, lane_x, lane_p } = scratch;
-    let (radii, bounds, maybe) = (&radii[..n], &mut bounds[..n - 1], &mut maybe[..n - 1]);
+    let Scratch { radii, bounds, lane_x, lane_p } = scratch;
+    let (radii, bounds) = (&radii[..n], &mut bounds[..n - 1]);
     segment_bounds(x, p, radii, bounds);
+    let bounds = &*bounds;
     let slop = F(std::array::from_fn(|lane| contacts[lane].slop));
     let mut drift = D::<L>::splat(0.0);
     // Each lane's next candidate; the colliders come in their order, as in the scalar pass.
@@ -108,81 +126,178 @@ fn pass<const L: usize>(
         }
         // Every lane's sweeps of a collider are copies of the same row.
         let sweep = collision::at(&contacts[first].sweeps[cursor[first] - 1], pose);
-        // With few lanes at this collider, the screen would do the work of all of them for those few.
-        let screened = here.0.iter().filter(|&&set| set).count() >= SCREEN_MIN_LANES;
-        let flagged =
-            if screened { screen(&Screen::new(&sweep), here, x, p, radii, bounds, drift, slop, maybe) } else { 0 };
         for lane in lanes_of(here) {
             passes[lane].tested += n as u64 - 1;
-            let contact = &mut contacts[lane];
-            let collider = OutsideCollider::new(&sweep, &contact.input(), DVec3::from_array(p[0].get(lane)));
-            // Segments before `held` join joints the root holds inside (or the root itself).
-            let held = collider.held.joints;
-            let mut exact = !screened;
-            if held > 0 && held < n - 1 {
-                // The held run's last segment: the scalar turn (rare), then the segment's test as any other.
-                let k = held;
-                extract(x, lane, lane_x);
-                extract(p, lane, lane_p);
-                let bound = (DVec3::from_array(bounds[k].0.get(lane)), bounds[k].1.0[lane]);
-                let mut normals = std::mem::take(&mut contact.normals);
-                collision::turn_held(
-                    lane_x,
-                    lane_p,
+        }
+        // With few lanes at this collider, the screen would do the work of all of them for those few.
+        if here.0.iter().filter(|&&set| set).count() < SCREEN_MIN_LANES {
+            for lane in lanes_of(here) {
+                let collider = OutsideCollider::new(&sweep, &contacts[lane].input(), DVec3::from_array(p[0].get(lane)));
+                let lane_scratch = (&mut *lane_x, &mut *lane_p);
+                scalar_turn(
+                    lane,
+                    x,
+                    p,
+                    bounds,
                     &sweep,
-                    &contact.input(),
+                    &mut contacts[lane],
                     &collider,
-                    bound,
                     &mut drift.0[lane],
-                    (pose == Pose::End).then_some(&mut normals[..]),
+                    &mut passes[lane],
+                    lane_scratch,
+                    pose,
+                );
+            }
+            continue;
+        }
+        let mut colliders = [None; L];
+        let mut screened = Mask([false; L]);
+        for lane in lanes_of(here) {
+            let collider = OutsideCollider::new(&sweep, &contacts[lane].input(), DVec3::from_array(p[0].get(lane)));
+            // A lane whose root holds joints inside takes the scalar turn and tests.
+            screened.0[lane] = collider.held.joints == 0;
+            colliders[lane] = Some(collider);
+        }
+        let mut resolve = |k: usize, touching: u32, x: &mut [DV3<L>], p: &mut [DV3<L>], drift: &mut D<L>| {
+            for lane in bits_of(touching) {
+                let collider = colliders[lane].as_ref().expect("a lane at the collider");
+                let moved = test_segment(
+                    k,
+                    lane,
+                    x,
+                    p,
+                    bounds,
+                    &sweep,
+                    &contacts[lane],
+                    collider,
+                    drift.0[lane],
                     &mut passes[lane],
                 );
-                contact.normals = normals;
-                write_back(lane_x, lane, x);
-                write_back(lane_p, lane, p);
-                exact = true;
-            } else if screened && flagged & 1 << lane == 0 {
-                continue;
+                drift.0[lane] += moved;
             }
-            for k in held..n - 1 {
-                if !exact && maybe[k] & 1 << lane == 0 {
-                    continue;
-                }
-                let input = contact.input();
-                let mut ends = SegmentEnds {
-                    start: [x[k].get(lane), x[k + 1].get(lane)].map(DVec3::from_array),
-                    p: [p[k].get(lane), p[k + 1].get(lane)].map(DVec3::from_array),
-                };
-                let bound = (DVec3::from_array(bounds[k].0.get(lane)), bounds[k].1.0[lane]);
-                let Some(found) = collision::segment_contact(k, bound, &ends, &sweep, &input, &collider, drift.0[lane])
-                else {
-                    continue;
-                };
-                drift.0[lane] +=
-                    collision::resolve_segment(k, &found, &sweep, input.friction, &mut ends, &mut passes[lane]);
-                x[k].set(lane, ends.start[0].to_array());
-                x[k + 1].set(lane, ends.start[1].to_array());
-                p[k].set(lane, ends.p[0].to_array());
-                p[k + 1].set(lane, ends.p[1].to_array());
-                exact = true;
-            }
+        };
+        screen(&Screen::new(&sweep), screened, x, p, radii, bounds, &mut drift, slop, &mut resolve);
+        for lane in lanes_of(here.and(screened.not())) {
+            let collider = colliders[lane].expect("a lane at the collider");
+            let lane_scratch = (&mut *lane_x, &mut *lane_p);
+            scalar_turn(
+                lane,
+                x,
+                p,
+                bounds,
+                &sweep,
+                &mut contacts[lane],
+                &collider,
+                &mut drift.0[lane],
+                &mut passes[lane],
+                lane_scratch,
+                pose,
+            );
         }
     }
     passes
 }
 
-/// The screen where there is none: every segment of the lanes of `lanes` may touch, so each lane takes the scalar
-/// test on all of them.
-pub fn flag_all<const L: usize>(lanes: Mask<L>, maybe: &mut [u32]) -> u32 {
-    let lanes = lanes.0.iter().enumerate().fold(0, |bits, (lane, &set)| bits | (set as u32) << lane);
-    maybe.fill(lanes);
-    lanes
+/// One lane's turn at a collider in `collision`'s scalar code: the held run's turn where its root holds joints
+/// inside (bug 9), then the test of every segment past them.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn scalar_turn<const L: usize>(
+    lane: usize,
+    x: &mut [DV3<L>],
+    p: &mut [DV3<L>],
+    bounds: &[(DV3<L>, D<L>)],
+    sweep: &ColliderSweep,
+    contact: &mut LaneContacts,
+    collider: &OutsideCollider,
+    drift: &mut f64,
+    pass: &mut ContactPass,
+    (lane_x, lane_p): (&mut Vec<DVec3>, &mut Vec<DVec3>),
+    pose: Pose,
+) {
+    let n = p.len();
+    // Segments before `held` join joints the root holds inside (or the root itself).
+    let held = collider.held.joints;
+    if held > 0 && held < n - 1 {
+        // The held run's last segment: the scalar turn (rare), then the segment's test as any other.
+        let k = held;
+        extract(x, lane, lane_x);
+        extract(p, lane, lane_p);
+        let bound = (DVec3::from_array(bounds[k].0.get(lane)), bounds[k].1.0[lane]);
+        let mut normals = std::mem::take(&mut contact.normals);
+        collision::turn_held(
+            lane_x,
+            lane_p,
+            sweep,
+            &contact.input(),
+            collider,
+            bound,
+            drift,
+            (pose == Pose::End).then_some(&mut normals[..]),
+            pass,
+        );
+        contact.normals = normals;
+        write_back(lane_x, lane, x);
+        write_back(lane_p, lane, p);
+    }
+    for k in held..n - 1 {
+        *drift += test_segment(k, lane, x, p, bounds, sweep, contact, collider, *drift, pass);
+    }
 }
 
-/// The lanes set in `mask`, in order (from a bit mask: two branches per lane set, not per lane).
+/// `collision::segment_contact` and, on a contact, `resolve_segment` for segment `k` of `lane`: returns how far
+/// it moved the lane's joints (zero without a contact).
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn lanes_of<const L: usize>(mask: Mask<L>) -> impl Iterator<Item = usize> {
-    let mut bits = mask.0.iter().enumerate().fold(0u32, |bits, (lane, &set)| bits | (set as u32) << lane);
+fn test_segment<const L: usize>(
+    k: usize,
+    lane: usize,
+    x: &mut [DV3<L>],
+    p: &mut [DV3<L>],
+    bounds: &[(DV3<L>, D<L>)],
+    sweep: &ColliderSweep,
+    contact: &LaneContacts,
+    collider: &OutsideCollider,
+    drift: f64,
+    pass: &mut ContactPass,
+) -> f64 {
+    let input = contact.input();
+    let mut ends = SegmentEnds {
+        start: [x[k].get(lane), x[k + 1].get(lane)].map(DVec3::from_array),
+        p: [p[k].get(lane), p[k + 1].get(lane)].map(DVec3::from_array),
+    };
+    let bound = (DVec3::from_array(bounds[k].0.get(lane)), bounds[k].1.0[lane]);
+    let Some(found) = collision::segment_contact(k, bound, &ends, sweep, &input, collider, drift) else {
+        return 0.0;
+    };
+    let moved = collision::resolve_segment(k, &found, sweep, input.friction, &mut ends, pass);
+    x[k].set(lane, ends.start[0].to_array());
+    x[k + 1].set(lane, ends.start[1].to_array());
+    p[k].set(lane, ends.p[0].to_array());
+    p[k + 1].set(lane, ends.p[1].to_array());
+    moved
+}
+
+/// The screen where there is none: every segment of the lanes of `lanes` may touch, so each lane takes the scalar
+/// test on all of them.
+#[allow(clippy::too_many_arguments)]
+pub fn every_segment<const L: usize>(
+    lanes: Mask<L>,
+    start: &mut [DV3<L>],
+    p: &mut [DV3<L>],
+    segments: usize,
+    drift: &mut D<L>,
+    resolve: &mut Resolve<'_, L>,
+) {
+    let lanes = lanes.0.iter().enumerate().fold(0, |bits, (lane, &set)| bits | (set as u32) << lane);
+    for k in 0..segments {
+        resolve(k, lanes, start, p, drift);
+    }
+}
+
+/// The lanes set in a bit mask, in order.
+#[inline(always)]
+fn bits_of(mut bits: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         (bits != 0).then(|| {
             let lane = bits.trailing_zeros() as usize;
@@ -190,6 +305,12 @@ fn lanes_of<const L: usize>(mask: Mask<L>) -> impl Iterator<Item = usize> {
             lane
         })
     })
+}
+
+/// The lanes set in `mask`, in order (from a bit mask: two branches per lane set, not per lane).
+#[inline(always)]
+fn lanes_of<const L: usize>(mask: Mask<L>) -> impl Iterator<Item = usize> {
+    bits_of(mask.0.iter().enumerate().fold(0u32, |bits, (lane, &set)| bits | (set as u32) << lane))
 }
 
 /// `collision::SegmentBounds::compute` on every lane.
@@ -353,8 +474,8 @@ mod tests {
         c
     }
 
-    /// A segment the screen clears is one whose scalar test finds no contact; the lanes it returns are those with a
-    /// flagged segment. Where the CPU has AVX2 it clears most segments; elsewhere it flags them all.
+    /// A segment the screen clears is one whose scalar test finds no contact, given the same positions and drift (the
+    /// pass resolves nothing here). Where the CPU has AVX2 it clears most segments; elsewhere it flags them all.
     #[test]
     fn the_screen_clears_only_segments_the_scalar_test_clears() {
         let mut numbers = Numbers(0x9e37_79b9_7f4a_7c15);
@@ -368,10 +489,24 @@ mod tests {
             let slop = F([1e-4; LANES]);
             let screen = Screen::new(&sweep);
             let all = Mask([true; LANES]);
-            let mut maybe = vec![u32::MAX; JOINTS - 1];
-            let lanes_flagged =
-                super::super::screen8(&screen, all, &c.start, &c.p, &c.radii, &bounds, drift, slop, &mut maybe);
-            assert_eq!(lanes_flagged, maybe.iter().fold(0, |all, bits| all | bits));
+            // Nothing is resolved: every segment is screened with the same positions and drift.
+            let mut maybe = [0u32; JOINTS - 1];
+            let (mut start, mut p, mut screened_drift) = (c.start.clone(), c.p.clone(), drift);
+            let mut record = |k: usize, lanes: u32, _: &mut [DV3<LANES>], _: &mut [DV3<LANES>], _: &mut D<LANES>| {
+                assert_eq!(maybe[k], 0, "segment {k} screened twice");
+                maybe[k] = lanes;
+            };
+            super::super::screen8(
+                &screen,
+                all,
+                &mut start,
+                &mut p,
+                &c.radii,
+                &bounds,
+                &mut screened_drift,
+                slop,
+                &mut record,
+            );
             for lane in 0..LANES {
                 let radii: Vec<f32> = c.radii.iter().map(|r| r.0[lane]).collect();
                 let lengths: Vec<f32> = c.lengths.iter().map(|l| l[lane]).collect();

@@ -6,7 +6,7 @@
 
 use std::arch::x86_64::*;
 
-use super::outside::{Screen, Turn};
+use super::outside::{Resolve, Screen, Turn};
 use super::simd::{D, DV3, F, Mask, V3};
 use crate::core::collision::ROOT_LEVER_MIN;
 
@@ -46,28 +46,31 @@ fn dv8(v: &DV3<8>) -> DV8 {
     DV8 { x: d8(&v.x), y: d8(&v.y), z: d8(&v.z) }
 }
 
-/// The screen of every segment against one collider (see `outside::ScreenFn`).
+/// The screen of every segment against one collider, segment after segment, with `resolve` taking the lanes
+/// each may touch (see `outside::ScreenFn`).
 #[allow(clippy::too_many_arguments)]
 #[target_feature(enable = "avx2")]
 pub fn screen_all(
     screen: &Screen<8>,
     lanes: Mask<8>,
-    start: &[DV3<8>],
-    p: &[DV3<8>],
+    start: &mut [DV3<8>],
+    p: &mut [DV3<8>],
     radii: &[F<8>],
     bounds: &[(DV3<8>, D<8>)],
-    drift: D<8>,
+    drift: &mut D<8>,
     slop: F<8>,
-    maybe: &mut [u32],
-) -> u32 {
-    let constants = Constants::new(screen, drift, slop);
+    resolve: &mut Resolve<'_, 8>,
+) {
+    let mut constants = Constants::new(screen, *drift, slop);
     let lanes = lanes.0.iter().enumerate().fold(0, |bits, (lane, &set)| bits | (set as i32) << lane);
-    let mut flagged = 0;
-    for (k, (maybe, bound)) in maybe.iter_mut().zip(bounds).enumerate() {
-        *maybe = segment(&constants, k, lanes, start, p, radii, bound) as u32;
-        flagged |= *maybe;
+    for (k, bound) in bounds.iter().enumerate() {
+        let touch = segment(&constants, k, lanes, start, p, radii, bound);
+        if touch != 0 {
+            resolve(k, touch as u32, start, p, drift);
+            // A contact moved the lane's joints: its drift grew.
+            constants.drift_3 = times_3(drift);
+        }
     }
-    flagged
 }
 
 /// What every segment's screen against the collider shares, in registers.
@@ -89,8 +92,6 @@ struct Constants {
 impl Constants {
     #[target_feature(enable = "avx2")]
     fn new(screen: &Screen<8>, drift: D<8>, slop: F<8>) -> Self {
-        let drift = d8(&drift);
-        let three = _mm256_set1_pd(3.0);
         Self {
             centre: dv8(&screen.centre),
             start_centre: dv8(&screen.start_centre),
@@ -98,13 +99,21 @@ impl Constants {
             to_start: Turn8::new(&screen.to_start),
             solid: _mm256_set1_pd(screen.solid),
             collider_travel: _mm256_set1_pd(screen.collider_travel),
-            drift_3: D8(_mm256_mul_pd(drift.0, three), _mm256_mul_pd(drift.1, three)),
+            drift_3: times_3(&drift),
             radius: f8(&screen.radius),
             half_height: f8(&screen.half_height),
             axis: (v8(&screen.axis.0), v8(&screen.axis.1)),
             slop: f8(&slop),
         }
     }
+}
+
+/// Three times each lane's drift, as the quick reject widens by it.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn times_3(drift: &D<8>) -> D8 {
+    let (drift, three) = (d8(drift), _mm256_set1_pd(3.0));
+    D8(_mm256_mul_pd(drift.0, three), _mm256_mul_pd(drift.1, three))
 }
 
 /// `outside::Turn` in registers.

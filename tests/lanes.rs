@@ -499,8 +499,8 @@ fn hair_ropes_that_keep_falling_back_match_the_scalar_solver() {
 
 /// A ball created where eight limp ropes hang, deep inside it (a collider created on the chains): the substep
 /// starts with pre-stabilisation's rounds of lengths and contacts at the start positions
-/// (`collision::pre_stabilise`), whose first contact pass the lane solver runs in lanes for a group of 8 where
-/// the CPU has AVX2 (`lanes::outside::pre_stabilise`), the rounds lane by lane. Limp ropes have no shape
+/// (`collision::pre_stabilise`), whose first contact pass the lane solver runs in lanes for a group of 8
+/// (`lanes::outside::pre_stabilise`, screened where the CPU has AVX2), the rounds lane by lane. Limp ropes have no shape
 /// matching, so both solvers must compute the very same positions and do the same work, frame by frame.
 #[test]
 fn ropes_a_ball_appears_around_match_the_scalar_solver() {

@@ -1,7 +1,8 @@
 //! The contact pass of a lane group, between the kernel's vector phases. Contacts are sparse (a few joints of a
 //! strand touch the head or a shoulder), branchy and different for every chain: each is resolved by
-//! `collision`'s scalar code. Against spheres and capsules, the lanes first screen every segment at once
-//! ([`outside`]); against other colliders the pass is `collision`'s, one lane at a time. The lanes also gain
+//! `collision`'s scalar code. Against spheres and capsules, in groups of 8, the lanes screen each segment at once,
+//! segment after segment, and only the lanes the screen cannot clear take the scalar test ([`outside`]; the
+//! first pass of pre-stabilisation too); against other colliders the pass is `collision`'s, one lane at a time. The lanes also gain
 //! the rest of the substep (shape matching and the lengths), which a chain near a collider would otherwise run
 //! on the scalar solver.
 

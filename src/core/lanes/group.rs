@@ -113,8 +113,8 @@ pub struct LaneGroup<const L: usize> {
     pub(super) memories: Vec<SolveMemory>,
     pub(super) constraints: ConstraintScratch,
     pub(super) segment_bounds: SegmentBounds,
-    /// The contact pass in lanes (`outside::collide`): each joint's collision radius and each segment's
-    /// quick-reject bound.
+    /// The contact passes in lanes (`outside::collide`, `outside::pre_stabilise`): each joint's collision radius
+    /// and each segment's quick-reject bound.
     pub(super) contact_radii: Vec<F<L>>,
     pub(super) contact_bounds: Vec<(DV3<L>, D<L>)>,
     /// Pre-stabilisation's copy of the start positions (`outside::pre_stabilise`).

@@ -1,5 +1,5 @@
 //! One substep of a lane group: [`rod::substep`](crate::core::rod::substep) for `L` chains of the same
-//! joint count at once (the contact pass, scalar, lane by lane: [`contacts`]). Same algorithm, same constants, same order of operations within
+//! joint count at once (the contacts: [`contacts`]). Same algorithm, same constants, same order of operations within
 //! a lane; only the data layout differs (one array per quantity, one lane per chain). Where the scalar
 //! solver branches on a value (convergence, a rotation too large for a series, a failed direct solve), the
 //! lanes keep a mask, and the rare lanes that need the scalar code get it one by one.
@@ -63,7 +63,8 @@ pub fn substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, phases: &Phases<L
 }
 
 /// [`substep`] for a group where some lanes may touch colliders, with `rod::substep`'s contact handling on
-/// those lanes (scalar, one lane at a time: [`contacts`]): pre-stabilisation, a contact pass after every
+/// those lanes ([`contacts`]: `collision`'s scalar code, screened in lanes against spheres and capsules):
+/// pre-stabilisation, a contact pass after every
 /// iteration, and the final rounds of lengths then contacts until the contacts settle. The other lanes do
 /// exactly what [`substep`] does. Returns the lanes that fell back and the (segment or particle, collider)
 /// pairs tested.

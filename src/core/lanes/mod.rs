@@ -22,8 +22,9 @@
 //!   or 2 after its full groups) changes its motion by rounding, never more; the same inputs always give the
 //!   same bits.
 //! - Chains that may touch a collider run in lanes too. Against spheres and capsules, the colliders of a
-//!   character, the contact pass screens every lane's segments at once and takes the scalar test and correction
-//!   only where a segment may touch ([`outside`]); against a ground plane or an inside collider it runs the
+//!   character, the contact pass (and pre-stabilisation's first pass) screens every lane's segment at once,
+//!   segment after segment, and takes the scalar test and correction only where a segment may touch
+//!   ([`outside`]); against a ground plane or an inside collider it runs the
 //!   scalar pass one lane at a time ([`contacts`]). Either way a chain's contacts are the scalar solver's, bit
 //!   for bit, given the same positions. The render pose is computed in lanes as well
 //!   ([`output`], the scalar code's operations); everything else a chain does (sleeping, teleports, momentum

@@ -130,7 +130,7 @@ fn pass<const L: usize>(
             passes[lane].tested += n as u64 - 1;
         }
         // With few lanes at this collider, the screen would do the work of all of them for those few.
-        if here.0.iter().filter(|&&set| set).count() < SCREEN_MIN_LANES {
+        if count(here) < SCREEN_MIN_LANES {
             for lane in lanes_of(here) {
                 let collider = OutsideCollider::new(&sweep, &contacts[lane].input(), DVec3::from_array(p[0].get(lane)));
                 let lane_scratch = (&mut *lane_x, &mut *lane_p);
@@ -157,6 +157,9 @@ fn pass<const L: usize>(
             // A lane whose root holds joints inside takes the scalar turn and tests.
             screened.0[lane] = collider.held.joints == 0;
             colliders[lane] = Some(collider);
+        }
+        if count(screened) < SCREEN_MIN_LANES {
+            screened = Mask([false; L]);
         }
         let mut resolve = |k: usize, touching: u32, x: &mut [DV3<L>], p: &mut [DV3<L>], drift: &mut D<L>| {
             for lane in bits_of(touching) {
@@ -293,6 +296,11 @@ pub fn every_segment<const L: usize>(
     for k in 0..segments {
         resolve(k, lanes, start, p, drift);
     }
+}
+
+/// The lanes set in `mask`.
+fn count<const L: usize>(mask: Mask<L>) -> usize {
+    mask.0.iter().filter(|&&set| set).count()
 }
 
 /// The lanes set in a bit mask, in order.
@@ -514,7 +522,8 @@ mod tests {
                     ContactInput { colliders: &[sweep], radii: &radii, lengths: &lengths, friction: 0.3, slop: 1e-4 };
                 let at = |v: &DV3<LANES>| DVec3::from_array(v.get(lane));
                 let collider = OutsideCollider::new(&sweep, &input, at(&c.p[0]));
-                // The segment leaving held joints always takes the scalar test (`collide`), screened or not.
+                // A lane whose root holds joints takes the scalar turn, unscreened (`pass`); the screen does not
+                // know the rule of the segment leaving the held joints.
                 let first = collider.held.joints + (collider.held.joints > 0) as usize;
                 for k in first..JOINTS - 1 {
                     let ends = SegmentEnds {
@@ -541,5 +550,102 @@ mod tests {
             return;
         }
         assert_eq!(cleared, 0, "no screen: every segment flagged");
+    }
+
+    /// The screen walks the segments in order and reads what the contacts before moved: at each segment it calls
+    /// back, a contact here moves the reported lanes' joints (start positions and positions of the segment's
+    /// ends, by up to 2 cm, or towards the collider) and adds to their drift, and the lanes it left out must be ones whose scalar test,
+    /// on the positions and drift as they are then, finds no contact. Some lanes are outside the mask and must
+    /// never be reported.
+    #[test]
+    fn the_screen_reads_the_positions_and_drift_the_contacts_before_left() {
+        let mut numbers = Numbers(0x2545_f491_4f6c_dd1d);
+        let (mut checked, mut reported, mut moved) = (0, 0, 0);
+        for _ in 0..1000 {
+            let sweep = sweep(&mut numbers);
+            let c = chains(&mut numbers);
+            let mut bounds = vec![(DV3::ZERO, D([0.0; LANES])); JOINTS - 1];
+            segment_bounds(&c.start, &c.p, &c.radii, &mut bounds);
+            let (mut start, mut p) = (c.start.clone(), c.p.clone());
+            let mut drift = D([0.0; LANES]);
+            let slop = F([1e-4; LANES]);
+            let mask: Mask<LANES> = Mask(std::array::from_fn(|_| numbers.unit() < 0.8));
+            let inputs: Vec<(Vec<f32>, Vec<f32>)> = (0..LANES)
+                .map(|lane| (c.radii.iter().map(|r| r.0[lane]).collect(), c.lengths.iter().map(|l| l[lane]).collect()))
+                .collect();
+            let input = |lane: usize| ContactInput {
+                colliders: std::slice::from_ref(&sweep),
+                radii: &inputs[lane].0,
+                lengths: &inputs[lane].1,
+                friction: 0.3,
+                slop: 1e-4,
+            };
+            let colliders: Vec<OutsideCollider> = (0..LANES)
+                .map(|lane| OutsideCollider::new(&sweep, &input(lane), DVec3::from_array(c.p[0].get(lane))))
+                .collect();
+            // Lanes whose root holds joints are never screened (`pass`).
+            let mask: Mask<LANES> = Mask(std::array::from_fn(|lane| mask.0[lane] && colliders[lane].held.joints == 0));
+            // Every segment up to `k`, of every lane in the mask, but those reported at `k`, tested on the state
+            // as the screen saw it (nothing moves between two calls).
+            let mut next = 0;
+            let mut check_up_to =
+                |k: usize, reported_here: u32, start: &[DV3<LANES>], p: &[DV3<LANES>], drift: &D<LANES>| {
+                    for j in next..=k.min(JOINTS - 2) {
+                        for lane in (0..LANES).filter(|&lane| mask.0[lane]) {
+                            if j == k && reported_here & 1 << lane != 0 {
+                                continue;
+                            }
+                            let at = |v: &DV3<LANES>| DVec3::from_array(v.get(lane));
+                            let ends = SegmentEnds {
+                                start: [at(&start[j]), at(&start[j + 1])],
+                                p: [at(&p[j]), at(&p[j + 1])],
+                            };
+                            let bound = (at(&bounds[j].0), bounds[j].1.0[lane]);
+                            let found =
+                                segment_contact(j, bound, &ends, &sweep, &input(lane), &colliders[lane], drift.0[lane]);
+                            assert!(found.is_none(), "segment {j} of lane {lane} left out but touching");
+                            checked += 1;
+                        }
+                    }
+                    next = k + 1;
+                };
+            let mut record =
+                |k: usize, lanes: u32, start: &mut [DV3<LANES>], p: &mut [DV3<LANES>], drift: &mut D<LANES>| {
+                    check_up_to(k, lanes, start, p, drift);
+                    for lane in (0..LANES).filter(|&lane| lanes & 1 << lane != 0) {
+                        assert!(mask.0[lane], "lane {lane} reported outside the mask");
+                        reported += 1;
+                        if numbers.unit() < 0.5 {
+                            continue;
+                        }
+                        moved += 1;
+                        let mut push = 0.0;
+                        for joint in [k, k + 1].into_iter().filter(|&joint| joint > 0) {
+                            // Towards the collider, or anywhere: a far joint may come within reach.
+                            let to_centre = sweep.end.centre - DVec3::from_array(p[joint].get(lane));
+                            let step = to_centre * numbers.between(0.0, 1.0) * numbers.between(0.0, 1.0).round()
+                                + numbers.direction() * numbers.between(0.0, 0.02);
+                            push += step.length();
+                            for v in [&mut start[joint], &mut p[joint]] {
+                                v.set(lane, (DVec3::from_array(v.get(lane)) + step).to_array());
+                            }
+                        }
+                        drift.0[lane] += push;
+                    }
+                };
+            super::super::screen8(
+                &Screen::new(&sweep),
+                mask,
+                &mut start,
+                &mut p,
+                &c.radii,
+                &bounds,
+                &mut drift,
+                slop,
+                &mut record,
+            );
+            check_up_to(JOINTS - 1, 0, &start, &p, &drift);
+        }
+        assert!(moved > 500 && checked > 20000, "{checked} segments checked, {reported} reported, {moved} moved");
     }
 }

@@ -402,12 +402,17 @@ fn drive_limp_side_by_side(
     for frame in 0..frames {
         drive(lanes, frame..frame + 1);
         drive(scalar, frame..frame + 1);
-        assert_eq!(lanes.stats().lane_chains, ids.len() as u32);
-        assert_eq!(lanes.stats().contact_pairs_tested, scalar.stats().contact_pairs_tested, "frame {frame}");
-        assert_eq!(lanes.stats().solver_fallbacks, scalar.stats().solver_fallbacks, "frame {frame}");
-        for (&id, &scalar_id) in ids.iter().zip(scalar_ids) {
-            assert_eq!(particle_bits(lanes, id), particle_bits(scalar, scalar_id), "frame {frame}");
-        }
+        assert_same_frame(lanes, ids, scalar, scalar_ids, frame);
+    }
+}
+
+/// After `frame`: every chain of `ids` in lanes, and the same contact pairs, fallbacks and bits on both solvers.
+fn assert_same_frame(lanes: &Engine, ids: &[ChainId], scalar: &Engine, scalar_ids: &[ChainId], frame: usize) {
+    assert_eq!(lanes.stats().lane_chains, ids.len() as u32);
+    assert_eq!(lanes.stats().contact_pairs_tested, scalar.stats().contact_pairs_tested, "frame {frame}");
+    assert_eq!(lanes.stats().solver_fallbacks, scalar.stats().solver_fallbacks, "frame {frame}");
+    for (&id, &scalar_id) in ids.iter().zip(scalar_ids) {
+        assert_eq!(particle_bits(lanes, id), particle_bits(scalar, scalar_id), "frame {frame}");
     }
 }
 
@@ -582,12 +587,7 @@ fn ropes_a_ball_appears_around(ball_centre: Vec3, ball_radius: f32) -> BallCreat
             engine.set_collider_transforms([head_pose, shoulder_pose, ball_pose].into_iter()).unwrap();
             engine.step(1.0 / 60.0, orbit_camera(HEAD, 3.0, frame as f32 * 0.05), head(frame)).unwrap();
         }
-        assert_eq!(lanes.stats().lane_chains, 8);
-        assert_eq!(lanes.stats().contact_pairs_tested, scalar.stats().contact_pairs_tested, "frame {frame}");
-        assert_eq!(lanes.stats().solver_fallbacks, scalar.stats().solver_fallbacks, "frame {frame}");
-        for (&id, &scalar_id) in ids.iter().zip(&scalar_ids) {
-            assert_eq!(particle_bits(&lanes, id), particle_bits(&scalar, scalar_id), "frame {frame}");
-        }
+        assert_same_frame(&lanes, &ids, &scalar, &scalar_ids, frame);
     }
     let (_, deepest_after) = inside_ball(&lanes);
     BallCreated { joints_inside, roots_inside, deepest_before, deepest_after }

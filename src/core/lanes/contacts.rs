@@ -84,7 +84,6 @@ impl LaneContacts {
 /// of it, in `collision`'s scalar code one lane at a time.
 #[inline(always)]
 pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, screen: Option<ScreenFn<L>>) {
-    let n = g.n;
     let mut in_lanes = Mask([false; L]);
     let mut scalar = Mask([false; L]);
     for lane in (0..L).filter(|&lane| lanes.0[lane]) {
@@ -104,58 +103,61 @@ pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, scree
         for lane in (0..L).filter(|&lane| in_lanes.0[lane]) {
             // Joints left on a surface by the last substep touch it within rounding: only a real overlap needs
             // rounds.
-            if passes[lane].deepest <= g.contacts[lane].settled {
-                continue;
+            if passes[lane].deepest > g.contacts[lane].settled {
+                pre_stabilise_lane(g, lane, true);
             }
-            let LaneGroup {
-                x,
-                contact_start,
-                lengths,
-                lane_x,
-                lane_scratch,
-                lane_lengths,
-                contacts,
-                constraints,
-                segment_bounds,
-                ..
-            } = g;
-            extract(&x[..n], lane, lane_x);
-            extract(&contact_start[..n], lane, lane_scratch);
-            lane_lengths.clear();
-            lane_lengths.extend(lengths[..n - 1].iter().map(|l| l.0[lane]));
-            let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
-                inextensible::solve(previous, x, lane_lengths, constraints);
-            };
-            let contact = &contacts[lane];
-            collision::pre_stabilise_rounds(
-                lane_x,
-                lane_scratch,
-                &contact.input(),
-                FINAL_CONTACT_ROUNDS,
-                keep_lengths,
-                contact.settled,
-                segment_bounds,
-            );
-            write_back(lane_x, lane, &mut x[..n]);
         }
     }
     for lane in (0..L).filter(|&lane| scalar.0[lane]) {
-        let LaneGroup { x, lengths, lane_x, lane_scratch, lane_lengths, contacts, constraints, segment_bounds, .. } = g;
-        extract(&x[..n], lane, lane_x);
-        lane_lengths.clear();
-        lane_lengths.extend(lengths[..n - 1].iter().map(|l| l.0[lane]));
+        pre_stabilise_lane(g, lane, false);
+    }
+}
+
+/// `collision::pre_stabilise` of one lane in `collision`'s scalar code: the whole of it, or (`after_first_pass`)
+/// the rounds after the first pass that [`outside::pre_stabilise`] ran in lanes, from the start positions it left
+/// in `LaneGroup::contact_start`.
+fn pre_stabilise_lane<const L: usize>(g: &mut LaneGroup<L>, lane: usize, after_first_pass: bool) {
+    let n = g.n;
+    let LaneGroup {
+        x,
+        contact_start,
+        lengths,
+        lane_x,
+        lane_scratch,
+        lane_lengths,
+        contacts,
+        constraints,
+        segment_bounds,
+        ..
+    } = g;
+    extract(&x[..n], lane, lane_x);
+    lane_lengths.clear();
+    lane_lengths.extend(lengths[..n - 1].iter().map(|l| l.0[lane]));
+    let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
+        inextensible::solve(previous, x, lane_lengths, constraints);
+    };
+    let contact = &contacts[lane];
+    let (input, settled) = (contact.input(), contact.settled);
+    if after_first_pass {
+        extract(&contact_start[..n], lane, lane_scratch);
+        collision::pre_stabilise_rounds(
+            lane_x,
+            lane_scratch,
+            &input,
+            FINAL_CONTACT_ROUNDS,
+            keep_lengths,
+            settled,
+            segment_bounds,
+        );
+    } else {
         lane_scratch.resize(n, DVec3::ZERO);
-        let keep_lengths = |previous: &[DVec3], x: &mut [DVec3]| {
-            inextensible::solve(previous, x, lane_lengths, constraints);
-        };
-        let contact = &contacts[lane];
         collision::pre_stabilise(
             lane_x,
             lane_scratch,
-            &contact.input(),
+            &input,
             FINAL_CONTACT_ROUNDS,
             keep_lengths,
-            contact.settled,
+            settled,
             segment_bounds,
         );
         if contact.starts_clear {
@@ -164,12 +166,11 @@ pub fn pre_stabilise<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, scree
                 crate::core::rod::same_bits(lane_x, lane_scratch),
                 "lane {lane} had something to pre-stabilise"
             );
-            continue;
+            return;
         }
-        write_back(lane_x, lane, &mut x[..n]);
     }
+    write_back(lane_x, lane, &mut x[..n]);
 }
-
 /// One contact pass (`collision::collide`) on the lanes in `lanes`, moving their positions and, where a joint
 /// was inside already at the start of the substep, their start positions. An iteration's pass (`fresh`)
 /// forgets the contact normals of the passes before; a contact round's adds to them. Returns the pairs tested.

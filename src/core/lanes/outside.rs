@@ -129,59 +129,45 @@ fn pass<const L: usize>(
         for lane in lanes_of(here) {
             passes[lane].tested += n as u64 - 1;
         }
-        // With few lanes at this collider, the screen would do the work of all of them for those few.
-        if count(here) < SCREEN_MIN_LANES {
-            for lane in lanes_of(here) {
-                let collider = OutsideCollider::new(&sweep, &contacts[lane].input(), DVec3::from_array(p[0].get(lane)));
-                let lane_scratch = (&mut *lane_x, &mut *lane_p);
-                scalar_turn(
-                    lane,
-                    x,
-                    p,
-                    bounds,
-                    &sweep,
-                    &mut contacts[lane],
-                    &collider,
-                    &mut drift.0[lane],
-                    &mut passes[lane],
-                    lane_scratch,
-                    pose,
-                );
-            }
-            continue;
-        }
         let mut colliders = [None; L];
         let mut screened = Mask([false; L]);
-        for lane in lanes_of(here) {
-            let collider = OutsideCollider::new(&sweep, &contacts[lane].input(), DVec3::from_array(p[0].get(lane)));
-            // A lane whose root holds joints inside takes the scalar turn and tests.
-            screened.0[lane] = collider.held.joints == 0;
-            colliders[lane] = Some(collider);
-        }
-        if count(screened) < SCREEN_MIN_LANES {
-            screened = Mask([false; L]);
-        }
-        let mut resolve = |k: usize, touching: u32, x: &mut [DV3<L>], p: &mut [DV3<L>], drift: &mut D<L>| {
-            for lane in bits_of(touching) {
-                let collider = colliders[lane].as_ref().expect("a lane at the collider");
-                let moved = test_segment(
-                    k,
-                    lane,
-                    x,
-                    p,
-                    bounds,
-                    &sweep,
-                    &contacts[lane],
-                    collider,
-                    drift.0[lane],
-                    &mut passes[lane],
-                );
-                drift.0[lane] += moved;
+        // With few lanes at this collider, the screen would do the work of all of them for those few.
+        if count(here) >= SCREEN_MIN_LANES {
+            for lane in lanes_of(here) {
+                let collider = OutsideCollider::new(&sweep, &contacts[lane].input(), DVec3::from_array(p[0].get(lane)));
+                // A lane whose root holds joints inside takes the scalar turn and tests.
+                screened.0[lane] = collider.held.joints == 0;
+                colliders[lane] = Some(collider);
             }
-        };
-        screen(&Screen::new(&sweep), screened, x, p, radii, bounds, &mut drift, slop, &mut resolve);
+            if count(screened) < SCREEN_MIN_LANES {
+                screened = Mask([false; L]);
+            }
+        }
+        if screened.any() {
+            let mut resolve = |k: usize, touching: u32, x: &mut [DV3<L>], p: &mut [DV3<L>], drift: &mut D<L>| {
+                for lane in bits_of(touching) {
+                    let collider = colliders[lane].as_ref().expect("a screened lane at the collider");
+                    let moved = test_segment(
+                        k,
+                        lane,
+                        x,
+                        p,
+                        bounds,
+                        &sweep,
+                        &contacts[lane],
+                        collider,
+                        drift.0[lane],
+                        &mut passes[lane],
+                    );
+                    drift.0[lane] += moved;
+                }
+            };
+            screen(&Screen::new(&sweep), screened, x, p, radii, bounds, &mut drift, slop, &mut resolve);
+        }
         for lane in lanes_of(here.and(screened.not())) {
-            let collider = colliders[lane].expect("a lane at the collider");
+            let collider = colliders[lane].unwrap_or_else(|| {
+                OutsideCollider::new(&sweep, &contacts[lane].input(), DVec3::from_array(p[0].get(lane)))
+            });
             let lane_scratch = (&mut *lane_x, &mut *lane_p);
             scalar_turn(
                 lane,

@@ -147,6 +147,8 @@ pub struct Engine {
     lanes: LaneSolver,
     /// The chains the lane solver steps in the current step, and the anchor progress of each substep.
     lane_jobs: Vec<LaneJob>,
+    /// The colliders each lane job can touch this step (`LaneJob::candidates`), found once per chain.
+    lane_candidates: Vec<u32>,
     lane_leftovers: Vec<LaneJob>,
     progress: Vec<f32>,
     /// How many chains the engine holds of each joint count: what the step's buffers are sized for.
@@ -186,6 +188,7 @@ impl Engine {
             solver: Solver::default(),
             lanes: LaneSolver::default(),
             lane_jobs: Vec::new(),
+            lane_candidates: Vec::new(),
             lane_leftovers: Vec::new(),
             progress: Vec::new(),
             chains_by_joints: BTreeMap::new(),
@@ -212,6 +215,7 @@ impl Engine {
         reserve_total(&mut self.progress, substeps);
         reserve_total(&mut self.collider_sweeps, substeps * colliders);
         reserve_total(&mut self.lane_jobs, chains);
+        reserve_total(&mut self.lane_candidates, chains * colliders);
         reserve_total(&mut self.lane_leftovers, chains);
         // Lane groups only for joint counts with enough chains to fill one (a single 1000-joint rope never
         // runs in lanes, and 16 lanes of it would take megabytes).
@@ -679,6 +683,8 @@ impl Engine {
             sweeps: &self.collider_sweeps,
             substeps: substeps as usize,
             scale: settings.scale,
+            // Filled below, chain by chain, for the lane solver's `Reach`.
+            lane_candidates: &[],
         };
         let teleport_distance = settings.teleport_distance * settings.scale;
 
@@ -686,6 +692,7 @@ impl Engine {
         let mut contact_pairs = 0u64;
         let mut idle = 0u32;
         let mut lane_chains = 0u32;
+        self.lane_candidates.clear();
         let view = self.view;
         let rest_update_ahead = |chains: &Arena<Chain>, slot: Option<&u32>| {
             if let Some(chain) = slot.and_then(|&slot| chains.at(slot as usize)) {
@@ -785,7 +792,11 @@ impl Engine {
             }
             if self.solver != Solver::Scalar && substeps > 0 {
                 let joints = chain.joint_count();
-                self.lane_jobs.push(LaneJob { slot, joints, start, target, constants, still, rebase });
+                let first = self.lane_candidates.len() as u32;
+                let found = &self.contact_scratch.candidates;
+                self.lane_candidates.extend(found.iter().map(|&c| c as u32));
+                let candidates = (first, found.len() as u32);
+                self.lane_jobs.push(LaneJob { slot, joints, start, target, constants, still, rebase, candidates });
                 continue;
             }
             rebase_now(chain);
@@ -804,7 +815,7 @@ impl Engine {
                 &mut self.lane_jobs,
                 &mut self.lane_leftovers,
                 &clock,
-                &reach,
+                &Reach { lane_candidates: &self.lane_candidates, ..reach },
                 portable,
             );
             fallbacks += lane_fallbacks;
@@ -826,11 +837,15 @@ impl Engine {
                     reach: &reach,
                 };
                 let (candidates, radii) = (&mut self.contact_scratch.candidates, &mut self.contact_scratch.radii);
-                reach.candidates(chain, &job.start, &job.target, candidates, radii);
+                let (first, count) = (job.candidates.0 as usize, job.candidates.1 as usize);
+                candidates.clear();
+                candidates.extend(self.lane_candidates[first..first + count].iter().map(|&c| c as usize));
+                reach.radii(chain, radii);
                 let (chain_fallbacks, pairs) = run.step(chain, Some(&mut self.contact_scratch), &mut self.scratch);
                 fallbacks += chain_fallbacks;
                 contact_pairs += pairs;
             }
+            self.lane_candidates.clear();
             for job in self.lane_jobs.drain(..) {
                 let chain = self.chains.at_mut(job.slot as usize).expect("live");
                 chain.track_sleep(job.still, substeps, h, &settings);

@@ -1,8 +1,8 @@
 //! Which colliders a chain can touch during a step (the broad phase): a collider on a layer of the chain's
 //! mask whose swept bounding sphere meets the chain's, or, for a ground plane, whose half-space it reaches.
-//! The engine asks once per chain and step, when it decides whether the chain is still; the lists of the
-//! chains it hands to the lane solver go along in one flat list (`LaneJob::candidates`). Asking again in the
-//! lane solver took 1.3 % of the instructions of `scene_cost 10 1000x16 colliders` (662.1M against 653.9M).
+//! The engine asks when it decides whether a chain is still (for the chains of the lane solver, only where the
+//! chain could be: its anchor and rest shape stay), and the lane solver asks for the chains it steps, so
+//! neither keeps a list per chain.
 
 use glam::Vec3;
 
@@ -26,9 +26,6 @@ pub(crate) struct Reach<'a> {
     pub substeps: usize,
     /// `EngineSettings::scale` (for the chains' collision radii).
     pub scale: f32,
-    /// The colliders each chain handed to the lane solver can touch, found once per step
-    /// (`LaneJob::candidates` says where a chain's lie).
-    pub lane_candidates: &'a [u32],
 }
 
 impl Reach<'_> {
@@ -43,9 +40,11 @@ impl Reach<'_> {
         radii: &mut Vec<f32>,
     ) {
         out.clear();
-        if !self.radii(chain, radii) {
+        let count = self.order.len();
+        if chain.params.collision_mask == 0 || count == 0 || self.substeps == 0 {
             return;
         }
+        chain.scaled_radii(self.scale, radii);
         let thickest = radii.iter().copied().fold(0.0, f32::max);
         let reach = chain.rest.positions[0].length() + chain.reach() * (1.0 + STRETCH_SLACK) + thickest;
         let chain_bound = Bound::of_motion(start.position, target.position, reach);
@@ -67,16 +66,6 @@ impl Reach<'_> {
                 out.push(c);
             }
         }
-    }
-
-    /// Writes `chain`'s scaled collision radii into `radii` when it can collide at all (returned), as
-    /// [`candidates`](Self::candidates) does; leaves `radii` as it was otherwise.
-    pub fn radii(&self, chain: &Chain, radii: &mut Vec<f32>) -> bool {
-        if chain.params.collision_mask == 0 || self.order.is_empty() || self.substeps == 0 {
-            return false;
-        }
-        chain.scaled_radii(self.scale, radii);
-        true
     }
 
     /// Collider `c`'s sweeps in the first and the last substep.

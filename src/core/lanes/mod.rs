@@ -142,9 +142,6 @@ pub(crate) struct LaneJob {
     pub still: bool,
     /// The shift of the engine origin its positions have yet to take this step (`Engine::advance`).
     pub rebase: Option<DVec3>,
-    /// Where the colliders it can touch this step lie in the step's list of them (`Reach::candidates`, found
-    /// once per chain and step by the engine): first index and count.
-    pub candidates: (u32, u32),
 }
 
 impl LaneJob {
@@ -542,11 +539,9 @@ fn run_group<const L: usize>(
         g.load_contacts(
             lane,
             reach.order.len(),
-            |lane_candidates, radii| {
+            |candidates, radii| {
                 if real {
-                    let (first, count) = (job.candidates.0 as usize, job.candidates.1 as usize);
-                    lane_candidates.extend(reach.lane_candidates[first..first + count].iter().map(|&c| c as usize));
-                    reach.radii(chain, radii);
+                    reach.candidates(chain, &job.start, &job.target, candidates, radii)
                 }
             },
             chain.params.friction,

@@ -184,7 +184,9 @@ pub(crate) const FEWEST_IN_A_GROUP: usize = 3;
 /// AVX2 (`step_cost 1000 16 10 sway` built at 28d84ce and at its parent, run alternately 16 times: median
 /// ratio). With AVX2 alone (two 256-bit halves per operation) groups of 16 were no faster than groups of 8, and
 /// on a Zen 1, which splits each 256-bit operation again, slower: 1.09x the time of `scene_cost 40 1000x16
-/// lanes` (`tools/ab.sh --abba`, stop 41).
+/// lanes` (`tools/ab.sh --abba`, stop 41). Nor did two groups of 8 whose shape-matching sweeps ran side by side,
+/// in the lane loops or in AVX2 intrinsics (stops 32-33 and 45, `docs/performance-history.md`): with 16 vector
+/// registers the second group's values spill, and the spills take back what the overlap gains.
 fn group_widths(len: usize, sixteen: bool) -> impl Iterator<Item = (usize, usize)> {
     let sixteens = if sixteen { len / 16 } else { 0 };
     let rest = len - 16 * sixteens;

@@ -468,6 +468,15 @@ mod tests {
         c
     }
 
+    /// A random collider, lanes of chains near it, and their segments' bounds.
+    fn case(numbers: &mut Numbers) -> (ColliderSweep, Chains, Vec<(DV3<LANES>, D<LANES>)>) {
+        let sweep = sweep(numbers);
+        let c = chains(numbers);
+        let mut bounds = vec![(DV3::ZERO, D([0.0; LANES])); JOINTS - 1];
+        segment_bounds(&c.start, &c.p, &c.radii, &mut bounds);
+        (sweep, c, bounds)
+    }
+
     /// A segment the screen clears is one whose scalar test finds no contact, given the same positions and drift (the
     /// pass resolves nothing here). Where the CPU has AVX2 it clears most segments; elsewhere it flags them all.
     #[test]
@@ -475,10 +484,7 @@ mod tests {
         let mut numbers = Numbers(0x9e37_79b9_7f4a_7c15);
         let (mut flagged, mut cleared, mut touching) = (0, 0, 0);
         for _ in 0..400 {
-            let sweep = sweep(&mut numbers);
-            let c = chains(&mut numbers);
-            let mut bounds = vec![(DV3::ZERO, D([0.0; LANES])); JOINTS - 1];
-            segment_bounds(&c.start, &c.p, &c.radii, &mut bounds);
+            let (sweep, c, bounds) = case(&mut numbers);
             let drift = D(std::array::from_fn(|_| if numbers.unit() < 0.5 { 0.0 } else { numbers.between(0.0, 0.05) }));
             let slop = F([1e-4; LANES]);
             let screen = Screen::new(&sweep);
@@ -548,10 +554,7 @@ mod tests {
         let mut numbers = Numbers(0x2545_f491_4f6c_dd1d);
         let (mut checked, mut reported, mut moved) = (0, 0, 0);
         for _ in 0..1000 {
-            let sweep = sweep(&mut numbers);
-            let c = chains(&mut numbers);
-            let mut bounds = vec![(DV3::ZERO, D([0.0; LANES])); JOINTS - 1];
-            segment_bounds(&c.start, &c.p, &c.radii, &mut bounds);
+            let (sweep, c, bounds) = case(&mut numbers);
             let (mut start, mut p) = (c.start.clone(), c.p.clone());
             let mut drift = D([0.0; LANES]);
             let slop = F([1e-4; LANES]);

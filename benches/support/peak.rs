@@ -178,6 +178,7 @@ fn lanewise<T: Copy, const L: usize>(op: impl Fn(T, T) -> T) -> impl Fn([T; L], 
 
 /// The lanes of an AVX2 register summed (only to keep every chain's result alive), for code that has
 /// `std::arch::x86_64::*` in scope and AVX2 enabled.
+#[cfg(target_arch = "x86_64")]
 macro_rules! sum_ps {
     () => {
         |v: &__m256| {
@@ -188,6 +189,7 @@ macro_rules! sum_ps {
     };
 }
 
+#[cfg(target_arch = "x86_64")]
 macro_rules! sum_pd {
     () => {
         |v: &__m256d| {

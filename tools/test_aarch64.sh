@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# The aarch64 build, linted and tested on this x86-64 machine: clippy for the aarch64 target, then the Rust
-# tests cross-compiled and run under qemu-user (the lane solver's portable kernel, the scalar solver on glam's
-# scalar code, no AVX2 screen). The C, C++ and C# harnesses build with the host's compilers and stay on x86-64.
-# Installs the target's standard library (rustup) and the cross linker and qemu (Debian packages) when missing.
+# The aarch64 build, linted and tested on this x86-64 machine: clippy for the aarch64 target, the Rust tests
+# cross-compiled and run under qemu-user (the lane solver's portable kernel, the scalar solver on glam's scalar
+# code, no AVX2 screen), then the C and C++ harnesses built with the cross compilers against the aarch64 shared
+# library and run there too. The C# tests (Mono) and valgrind stay on x86-64. Installs the target's standard
+# library (rustup) and the cross compilers and qemu (Debian packages) when missing.
 #
-#   tools/test_aarch64.sh            # what .ci/run runs
-#   tools/test_aarch64.sh --test lanes   # extra arguments go to `cargo test` instead of the default set
+#   tools/test_aarch64.sh                # what .ci/run runs
+#   tools/test_aarch64.sh --test lanes   # extra arguments go to `cargo test` instead, and nothing else runs
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -13,6 +14,7 @@ target=aarch64-unknown-linux-gnu
 rustup target list --installed | grep -qx "$target" || rustup target add "$target"
 missing=()
 command -v aarch64-linux-gnu-gcc >/dev/null 2>&1 || missing+=(gcc-aarch64-linux-gnu libc6-dev-arm64-cross)
+command -v aarch64-linux-gnu-g++ >/dev/null 2>&1 || missing+=(g++-aarch64-linux-gnu)
 command -v qemu-aarch64 >/dev/null 2>&1 || missing+=(qemu-user)
 if [ ${#missing[@]} -gt 0 ]; then
     echo "installing: ${missing[*]}"
@@ -36,3 +38,20 @@ fi
 tests=(lanes engine physics reference skipping collisions character sketch no_alloc no_alloc_changes stress
     ffi_bad_input ffi_batch ffi_fuzz exports header)
 cargo test --release --target "$target" --lib "${tests[@]/#/--test=}"
+
+# The harnesses with the flags of tests/c_harness.rs and tests/cpp_bindings.rs; each ends on `N passed, 0 failed`.
+cargo build --release --target "$target" --lib
+lib=$(cd "$CARGO_TARGET_DIR/$target/release" && pwd)
+out=$(mktemp -d)
+run() { qemu-aarch64 -L /usr/aarch64-linux-gnu "$@" | tee "$out/log"; tail -1 "$out/log" | grep -Eq '^[1-9][0-9]* passed, 0 failed$'; }
+aarch64-linux-gnu-gcc -std=c11 -Wall -Wextra -Wpedantic -Werror -O1 -g -I include -I tests/c tests/c/*.c \
+    -o "$out/c_harness" -L "$lib" -Wl,-rpath,"$lib" -lkodawari -lm
+run "$out/c_harness"
+cxx=(aarch64-linux-gnu-g++ -std=c++17 -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wsign-conversion -Werror -g
+    -I include -I bindings/cpp)
+"${cxx[@]}" -c tests/cpp/test_kodawari.cpp -o "$out/test_kodawari.o"
+"${cxx[@]}" -DKODAWARI_NO_EXCEPTIONS -fno-exceptions -c tests/cpp/test_no_exceptions.cpp -o "$out/test_no_exceptions.o"
+aarch64-linux-gnu-g++ "$out/test_kodawari.o" "$out/test_no_exceptions.o" -o "$out/cpp_harness" \
+    -L "$lib" -Wl,-rpath,"$lib" -lkodawari -ldl
+run "$out/cpp_harness"
+echo "aarch64: the C and C++ harnesses passed"

@@ -1,5 +1,6 @@
 //! Small math helpers on top of glam: rigid transforms and the quaternion operations the shape code needs.
 
+use super::elementary;
 use glam::{DVec3, Quat, Vec3};
 
 /// A rigid transform: rotate, then translate. Mirrors Unity's `Transform` (position + rotation).
@@ -158,7 +159,7 @@ pub fn log_small(q: Quat) -> Vec3 {
 #[inline]
 pub fn rotation_angle(q: Quat) -> f32 {
     // atan2 keeps full precision for small angles, where acos(w) loses half the digits.
-    2.0 * q.xyz().length().atan2(q.w.abs())
+    2.0 * elementary::atan2(q.xyz().length(), q.w.abs())
 }
 
 /// `q` normalised, for any finite non-zero input (tiny or huge components alike: the largest component

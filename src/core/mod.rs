@@ -23,6 +23,7 @@ pub(crate) mod buffers;
 pub mod chain;
 pub mod collider;
 pub mod collision;
+pub(crate) mod elementary;
 pub mod engine;
 pub mod error;
 pub(crate) mod glam_order;

@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 
+use super::elementary;
 use super::error::{Error, Result};
 
 /// Where a chain's anchor (the kinematic bone joint 0 is attached to) comes from.
@@ -227,7 +228,7 @@ impl ChainParams {
         }
         let omega = STIFFNESS_FREQUENCY * self.stiffness / (1.0 - self.stiffness);
         let x = omega * h;
-        -(-(x * x)).exp_m1()
+        -elementary::exp_m1(-(x * x))
     }
 
     /// The per-iteration fraction whose `iterations`-fold application equals the per-substep one.
@@ -236,7 +237,7 @@ impl ChainParams {
         if a >= 1.0 || a <= 0.0 {
             return a;
         }
-        -((1.0 - a).ln() / iterations as f32).exp_m1()
+        -elementary::exp_m1(elementary::ln(1.0 - a) / iterations as f32)
     }
 }
 

@@ -6,6 +6,7 @@ use glam::{DVec3, Mat3A, Quat, Vec3, Vec3A};
 
 use super::arcs::ArcColumns;
 use super::collision::{ContactInput, SegmentBounds, collide, pre_stabilise};
+use super::elementary;
 use super::inextensible::{self, ConstraintScratch, SlidingMemory, SolveMemory};
 use super::math::{Transform, align_hemisphere, exp_small, log_small, nlerp_shorter};
 use super::params::{ChainParams, EngineSettings};
@@ -116,7 +117,7 @@ impl ChainConstants {
     pub fn new(params: &ChainParams, settings: &EngineSettings, h: f32, iterations: u32) -> Self {
         Self {
             alpha_per_iteration: params.alpha_per_iteration(h, iterations),
-            velocity_decay: (-params.damping * h).exp(),
+            velocity_decay: elementary::exp(-params.damping * h),
             gravity: settings.gravity * (params.gravity_scale * settings.scale),
             orientation_weight: (params.radius * settings.scale).powi(2) / 5.0,
         }

@@ -39,6 +39,7 @@
 
 use glam::{DQuat, DVec2, DVec3, Mat3, Quat, Vec2, Vec3};
 
+use super::elementary;
 use super::error::{Error, Result};
 use super::math::{Transform, normalized_direction, normalized_rotation};
 use super::shape::Shape;
@@ -165,7 +166,7 @@ impl StrokeCamera {
             ForwardAxis::PositiveZ => DVec3::Z,
         };
         let (perspective, scale) = match self.projection {
-            Projection::Perspective { vertical_fov } => (true, (0.5 * vertical_fov as f64).tan()),
+            Projection::Perspective { vertical_fov } => (true, elementary::tan_f64(0.5 * vertical_fov as f64)),
             Projection::Orthographic { half_height } => (false, half_height as f64),
         };
         Lens {

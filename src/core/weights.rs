@@ -2,6 +2,7 @@
 
 use glam::Vec3;
 
+use super::elementary;
 use super::math::{Transform, direction};
 
 /// Direction from the view reference joint K to the camera, in K's local frame; `None` when the camera
@@ -29,7 +30,7 @@ pub fn blend_weights(view: Vec3, shapes: impl IntoIterator<Item = ViewWeighting>
     for (shape, w) in shapes.into_iter().zip(out.iter_mut()) {
         // Clamp: rounding can push the cosine a hair past +-1, and powf of a negative base is NaN.
         let closeness = ((shape.direction.dot(view) + 1.0) * 0.5).clamp(0.0, 1.0);
-        *w = closeness.powf(shape.influence);
+        *w = elementary::powf(closeness, shape.influence);
         sum += *w;
     }
     if sum >= 1.0 {

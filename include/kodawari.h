@@ -595,6 +595,13 @@ const char *kdw_version_string(void);
 // `KDW_SOLVER_LANES_PORTABLE` always runs the portable kernel. Static, NUL-terminated, never NULL.
 const char *kdw_simd_path(void);
 
+// 1 if this library was built with the `portable-determinism` cargo feature, else 0. Builds with it compute the
+// same bits on x86-64 and aarch64, as their arithmetic calls no C library function (a replay recorded on one
+// plays back on the other, and lockstep peers stay in step); builds without it agree only with themselves on
+// one kind of machine. Hosts that rely on it check it on every peer, and compare `kdw_engine_state_hash`es to
+// detect a divergence.
+uint32_t kdw_portable_determinism(void);
+
 // Adds a view shape to a chain: when the camera is seen from `direction` (in the view reference joint's
 // local frame; need not be unit, must not be zero), the chain's rest shape becomes `joints` (anchor frame,
 // as many as the chain has). Only its bends and orientations are used: the root position and segment

@@ -2166,6 +2166,7 @@ fn special_tags() -> BTreeMap<&'static str, Vec<String>> {
         "kdw_abi_version",
         "kdw_version_string",
         "kdw_simd_path",
+        "kdw_portable_determinism",
         "kdw_status_str",
         "kdw_stroke_camera_default",
         "kdw_collider_def_default",
@@ -2339,6 +2340,7 @@ fn constant_queries() {
     let simd = unsafe { CStr::from_ptr(kdw_simd_path()) }.to_str().unwrap();
     assert!(["avx512", "avx2", "sse2", "neon", "scalar"].contains(&simd), "kdw_simd_path() = {simd:?}");
     assert_eq!(simd, kodawari::simd_path());
+    assert_eq!(kdw_portable_determinism(), u32::from(cfg!(feature = "portable-determinism")));
     assert_eq!(kdw_engine_def_default().struct_size as usize, size_of::<kdw_engine_def>());
     assert_eq!(kdw_chain_def_default().struct_size as usize, size_of::<kdw_chain_def>());
     assert_eq!(kdw_collider_def_default().struct_size as usize, size_of::<kdw_collider_def>());

@@ -71,6 +71,10 @@ inline const char* versionString() noexcept { return kdw_version_string(); }
 /// x86-64 kernel), "neon" or "scalar". Static, never null.
 inline const char* simdPath() noexcept { return kdw_simd_path(); }
 
+/// Whether the library was built with `portable-determinism`: the same bits on x86-64 and aarch64 (replays,
+/// lockstep). Check it on every peer that must agree.
+inline bool portableDeterminism() noexcept { return kdw_portable_determinism() != 0; }
+
 /// Which solver steps an engine's chains (KDW_SOLVER_*). They agree up to float
 /// rounding; a chain's bits never depend on its lane, its group or the kernel copy.
 enum class Solver : uint32_t {

@@ -30,3 +30,13 @@ pub extern "C" fn kdw_simd_path() -> *const c_char {
     // The core's names contain no NUL, so the conversion cannot fail (the empty default is never used).
     PATH.get_or_init(|| CString::new(crate::core::simd_path()).unwrap_or_default()).as_ptr()
 }
+
+/// 1 if this library was built with the `portable-determinism` cargo feature, else 0. Builds with it compute the
+/// same bits on x86-64 and aarch64, as their arithmetic calls no C library function (a replay recorded on one
+/// plays back on the other, and lockstep peers stay in step); builds without it agree only with themselves on
+/// one kind of machine. Hosts that rely on it check it on every peer, and compare `kdw_engine_state_hash`es to
+/// detect a divergence.
+#[unsafe(no_mangle)]
+pub extern "C" fn kdw_portable_determinism() -> u32 {
+    crate::core::portable_determinism() as u32
+}

@@ -1094,7 +1094,8 @@ static int solver_scene(kdw_engine **out, uint32_t solver)
 /* kdw_engine_set_solver / kdw_engine_get_solver round trips, kdw_engine_stats.lane_chains counts the chains the
  * lane solver stepped (all four on both lane solvers, none on the scalar one), the two lane solvers give the
  * same bits (the kernel copy does not change a chain's result), the scalar solver agrees up to rounding, and the
- * solver is part of the state hash. kdw_simd_path names the kernel. */
+ * solver is part of the state hash. kdw_simd_path names the kernel; kdw_portable_determinism says the build has
+ * no `portable-determinism`. */
 static int test_solver_selection(void)
 {
     const char *path = kdw_simd_path();
@@ -1102,6 +1103,7 @@ static int test_solver_selection(void)
     ENSURE(strcmp(path, "avx512") == 0 || strcmp(path, "avx2") == 0 || strcmp(path, "sse2") == 0 ||
            strcmp(path, "neon") == 0 || strcmp(path, "scalar") == 0);
     ENSURE(kdw_simd_path() == path); /* static */
+    ENSURE(kdw_portable_determinism() == 0); /* the harness links the default build (tests/common/native.rs) */
 
     const uint32_t solvers[3] = {KDW_SOLVER_LANES, KDW_SOLVER_LANES_PORTABLE, KDW_SOLVER_SCALAR};
     const uint32_t expected_lane_chains[3] = {SOLVER_CHAINS, SOLVER_CHAINS, 0};

@@ -109,6 +109,7 @@ void test_defaults_and_versions() {
     CHECK(std::string(kodawari::versionString()).size() > 0);
     const std::string simd = kodawari::simdPath();
     CHECK(simd == "avx512" || simd == "avx2" || simd == "sse2" || simd == "neon" || simd == "scalar");
+    CHECK(!kodawari::portableDeterminism()); // the harness links the default build (tests/common/native.rs)
     CHECK(std::string(kodawari::statusString(KDW_STATUS_INVALID_ID)) == kdw_status_str(KDW_STATUS_INVALID_ID));
 }
 

@@ -69,6 +69,7 @@ static unsafe class SolverTests
         string simd = Library.SimdPath;
         Ensure(simd == "avx512" || simd == "avx2" || simd == "sse2" || simd == "neon" || simd == "scalar", "SIMD path " + simd);
         Ensure(ReferenceEquals(simd, Library.SimdPath), "SIMD path read once");
+        Ensure(!Library.PortableDeterminism, "the tests load the default build, without portable-determinism");
 
         var solvers = new[] { Solver.Lanes, Solver.LanesPortable, Solver.Scalar };
         var expectedLaneChains = new[] { Chains, Chains, 0 };

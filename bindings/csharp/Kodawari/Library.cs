@@ -35,6 +35,10 @@ namespace Kodawari
             }
         }
 
+        /// <summary>Whether the loaded native library was built with <c>portable-determinism</c>: the same bits on
+        /// x86-64 and aarch64 (replays, lockstep). Check it on every peer that must agree.</summary>
+        public static bool PortableDeterminism { get { return NativeMethods.kdw_portable_determinism() != 0; } }
+
         /// <summary>Throws when the loaded library does not match these bindings: a different ABI version, or
         /// struct layouts that differ from the C ABI's (28-byte transforms). Cheap after the first success;
         /// <see cref="Engine"/> calls it before creating anything.</summary>

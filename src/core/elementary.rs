@@ -2,11 +2,12 @@
 //! feature, see `Cargo.toml`).
 //!
 //! By default they are the standard library's, which calls the C library's `expf`, `powf` and so on. Those
-//! round differently from one C library, CPU or architecture to another: glibc 2.36 picks FMA variants at run
-//! time on x86-64 and is built with fused multiply-adds on aarch64, and its x86-64 and aarch64 builds were
-//! seen to give different bits (`scene_cost 20 100x16 lod2`, `docs/performance-history.md`, stop 47). With
-//! `portable-determinism` they are the `libm` crate's instead: plain Rust that rustc compiles without fusing or
-//! reordering anything, so the same bits on every target.
+//! round differently from one C library, CPU or architecture to another: glibc 2.36's aarch64 `expm1f` and
+//! `atan2f` are compiled with fused multiply-adds (12 and 2 of them) where its x86-64 ones have none, so the two
+//! give other bits on some inputs (`examples/elementary_bits.rs`), and that split `scene_cost 20 100x16 lod2`
+//! across the architectures (`docs/performance-history.md`, stop 47). With `portable-determinism` they are the
+//! `libm` crate's instead: plain Rust that rustc compiles without fusing or reordering anything, so the same bits
+//! on every target.
 
 #[cfg(not(feature = "portable-determinism"))]
 mod chosen {

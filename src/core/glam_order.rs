@@ -14,10 +14,6 @@ macro_rules! glam_sse2 {
     ($($item:item)*) => { $( #[cfg(all(target_arch = "x86_64", not(feature = "portable-determinism")))] $item )* };
 }
 
-macro_rules! glam_scalar {
-    ($($item:item)*) => { $( #[cfg(not(all(target_arch = "x86_64", not(feature = "portable-determinism"))))] $item )* };
-}
-
 glam_sse2! {
     /// `Quat * Quat` (rtm's `quat_mul`).
     #[inline(always)]
@@ -44,9 +40,9 @@ glam_sse2! {
     }
 }
 
-glam_scalar! {
-    pub use super::lanes::scalar::{dot4 as dot, mul, normalize};
-}
+// Else glam's scalar code, which the lane kernel's mirrors are.
+#[cfg(not(all(target_arch = "x86_64", not(feature = "portable-determinism"))))]
+pub use super::lanes::scalar::{dot4 as dot, mul, normalize};
 
 /// `Quat::conjugate` (and `Quat::inverse`, which is it).
 #[inline(always)]

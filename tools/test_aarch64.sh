@@ -23,7 +23,8 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 export CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_LINKER=aarch64-linux-gnu-gcc
-export CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_RUNNER="qemu-aarch64 -L /usr/aarch64-linux-gnu"
+qemu=(qemu-aarch64 -L /usr/aarch64-linux-gnu)
+export CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_RUNNER="${qemu[*]}"
 # Its own target directory: the x86-64 build's stays warm.
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-target/aarch64}
 # Without the release profile's whole-program optimisation, which only saves time at run time and changes no
@@ -43,7 +44,8 @@ cargo test --release --target "$target" --lib "${tests[@]/#/--test=}"
 cargo build --release --target "$target" --lib
 lib=$(cd "$CARGO_TARGET_DIR/$target/release" && pwd)
 out=$(mktemp -d)
-run() { qemu-aarch64 -L /usr/aarch64-linux-gnu "$@" | tee "$out/log"; tail -1 "$out/log" | grep -Eq '^[1-9][0-9]* passed, 0 failed$'; }
+trap 'rm -rf "$out"' EXIT
+run() { "${qemu[@]}" "$@" | tee "$out/log"; tail -1 "$out/log" | grep -Eq '^[1-9][0-9]* passed, 0 failed$'; }
 aarch64-linux-gnu-gcc -std=c11 -Wall -Wextra -Wpedantic -Werror -O1 -g -I include -I tests/c tests/c/*.c \
     -o "$out/c_harness" -L "$lib" -Wl,-rpath,"$lib" -lkodawari -lm
 run "$out/c_harness"
@@ -65,7 +67,7 @@ runs=("20 100x16 lanes" "20 100x16 scalar" "20 100x16 views" "10 100x16 collider
     "20 100x16 lod2" "20 ragged views" "10 ragged colliders" "4 1x1000 colliders")
 for scene in "${runs[@]}"; do
     # shellcheck disable=SC2086 # the words of a scene are the example's arguments
-    arm=$(qemu-aarch64 -L /usr/aarch64-linux-gnu "$lib/examples/scene_cost" $scene | sed -n 1p)
+    arm=$("${qemu[@]}" "$lib/examples/scene_cost" $scene | sed -n 1p)
     # shellcheck disable=SC2086
     x86=$("$x86_dir/release/examples/scene_cost" $scene | sed -n 1p)
     echo "scene_cost $scene: aarch64 $arm, x86-64 $x86"

@@ -289,7 +289,7 @@ impl Engine {
         Ok(id)
     }
 
-    fn chain(&self, id: ChainId) -> Result<&Chain> {
+    pub(crate) fn chain(&self, id: ChainId) -> Result<&Chain> {
         self.chains
             .get(id)
             .ok_or_else(|| Error::invalid_id(format!("chain id {:#x} is null, stale or foreign", id.to_bits())))

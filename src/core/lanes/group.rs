@@ -283,7 +283,7 @@ impl<const L: usize> LaneGroup<L> {
                 (member.x.0, member.y.0, member.z.0) = (from[0], from[1], from[2]);
             }
         }
-        if self.substeps < 2 {
+        if self.one_substep() {
             // The one capture of the step turns the chain's newest pose into the previous one.
             for j in 0..n {
                 for (lane, chain) in chains.iter().enumerate() {
@@ -431,11 +431,12 @@ impl<const L: usize> LaneGroup<L> {
         vectors_to_lanes(&self.w[..n], &mut self.rows32, w);
         quaternions_to_lanes(&self.q[..n], &mut self.rows32, q);
         quaternions_to_lanes(&self.group_rotation[..n], &mut self.rows32, rotation);
-        // The render poses: 7 numbers a joint (position, rotation), a row per pose and lane.
+        // The render poses: 7 numbers a joint (position, rotation), a row per pose and lane. The previous one of a
+        // step of one substep is the chain's newest pose as it loaded: `store_render` takes it from the chain.
+        let skipped = self.one_substep() as usize;
         let poses = &mut self.lanes32[RENDER_START * n * L..];
-        for (pose, lanes) in
-            [&self.local_previous, &self.local_current, &self.output].into_iter().zip(poses.chunks_exact_mut(7 * n * L))
-        {
+        let stored = [&self.local_previous, &self.local_current, &self.output];
+        for (pose, lanes) in stored.into_iter().zip(poses.chunks_exact_mut(7 * n * L)).skip(skipped) {
             let rows = &mut self.rows32[..7 * n];
             for (to, (position, rotation)) in rows.chunks_exact_mut(7).zip(&pose[..n]) {
                 (to[0], to[1], to[2]) = (position.x.0, position.y.0, position.z.0);
@@ -484,22 +485,37 @@ impl<const L: usize> LaneGroup<L> {
         }
     }
 
-    /// The render poses of `lane` (`lanes::output`) into its chain's buffers.
+    /// The render poses of `lane` (`lanes::output`) into its chain's buffers. After a step of one substep the
+    /// previous pose is the one the chain held as its newest (its single capture shifted that pose, as loaded,
+    /// into the previous one: the same bits), so the chain's two buffers swap and only the newest and the output
+    /// are written. On a LOD 2 frame (one substep) writing the three poses was the costliest part of `run_group`.
     pub(crate) fn store_render(
         &self,
         lane: usize,
-        previous: &mut [Transform],
-        current: &mut [Transform],
+        previous: &mut Vec<Transform>,
+        current: &mut Vec<Transform>,
         output: &mut [Transform],
     ) {
         let n = self.n;
         let poses = &self.lanes32[RENDER_START * n * L..];
-        for (pose, to) in [previous, current, output].into_iter().enumerate() {
+        let write = |pose: usize, to: &mut [Transform]| {
             let row = &poses[(pose * L + lane) * 7 * n..][..7 * n];
             for (to, from) in to[..n].iter_mut().zip(row.chunks_exact(7)) {
                 *to = Transform::new(Vec3::from_slice(&from[..3]), Quat::from_slice(&from[3..]));
             }
+        };
+        if self.one_substep() {
+            std::mem::swap(previous, current);
+        } else {
+            write(0, previous);
         }
+        write(1, current);
+        write(2, output);
+    }
+
+    /// Whether the step has one substep: its one capture makes the loaded newest pose the previous one.
+    fn one_substep(&self) -> bool {
+        self.substeps < 2
     }
 }
 

@@ -53,7 +53,8 @@ pub use params::{AnchorSource, ChainParams, EngineSettings, TeleportMode};
 
 /// Whether this build has `portable-determinism`: the same inputs give the same bits on x86-64 and aarch64, as
 /// the arithmetic calls no C library function (README, "Same bits on x86-64 and aarch64"). Builds without it
-/// agree only with themselves on one kind of machine. Hosts that replay or run in lockstep across machines check it on every peer.
+/// agree only with themselves on one kind of machine. Hosts that replay or run in lockstep across machines check
+/// it on every peer.
 pub const fn portable_determinism() -> bool {
     cfg!(feature = "portable-determinism")
 }

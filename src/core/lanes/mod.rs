@@ -627,6 +627,7 @@ mod tests {
                 _ => two += 1,
             }
         }
+        println!("{one} frames of one substep checked, {two} of two");
         assert!(one >= 15 && two >= 15, "{one} frames of one substep, {two} of two");
     }
 

@@ -21,12 +21,14 @@ use scenes::{
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: scene_cost FRAMES 100x16|1000x16|16384x16|1x1000|1x1000_hair|ragged [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest|lod1|lod2|views|limp]";
+    let usage = "usage: scene_cost FRAMES 1x8|100x16|1000x16|16384x16|1x256|1x1000|1x1000_hair|ragged [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest|lod1|lod2|views|limp]";
     let frames: u64 = args.first().and_then(|f| f.parse().ok()).expect(usage);
     let scene = match args.get(1).map(String::as_str) {
+        Some("1x8") => Scene::uniform("1x8", 1, 8),
         Some("100x16") => Scene::uniform("100x16", 100, 16),
         Some("1000x16") => Scene::uniform("1000x16", 1000, 16),
         Some("16384x16") => Scene::uniform("16384x16", 16384, 16),
+        Some("1x256") => Scene::uniform("1x256", 1, 256),
         Some("1x1000") => Scene::uniform("1x1000", 1, 1000),
         Some("1x1000_hair") => Scene::uniform("1x1000_hair", 1, 1000).with_segment(0.025),
         Some("ragged") => Scene::ragged("ragged", 200, 4, 32),

@@ -208,10 +208,10 @@ pub fn solve_again(
 /// the lengths stop undoing the contact that gave it. The direct solve runs so restricted and, where it
 /// fails, the Gauss-Newton fallback too; where that fails as well, the lengths are met as [`solve_prepared`]
 /// meets them (contacts aside), from where that projection got to if it is nearer the lengths than the
-/// positions given, else from those. Met from the positions given, they undid the round's contacts: on the
-/// report's 0.8 m rope of 1000 joints with colliders, the projection fails in the first rounds of a substep
-/// (its start is a third to a half off the lengths) and the contacts stayed half a millimetre deep for up
-/// to ten rounds. Returns `false` when the restricted direct solve failed (a fallback ran).
+/// positions given, else from those. On the report's 0.8 m rope of 1000 joints with colliders, the
+/// projection fails in the first rounds of a substep (its start is 0.4 to 0.5 off in `|b|^2 / l^2 - 1`);
+/// met from the positions given, the lengths left the contacts about as deep as before, half a millimetre,
+/// for up to ten rounds. Returns `false` when the restricted direct solve failed (a fallback ran).
 ///
 /// `memory` is how the substep's earlier sliding solves ended. On long chains of fine segments (bug 1 in
 /// docs/robustness.md) the restricted direct solve fails round after round (on the report's 0.8 m rope of
@@ -1270,6 +1270,7 @@ mod tests {
         ));
 
         let mut p = given.clone();
+        // A memory of one failed round: straight to the projection, as in the rounds after the first.
         let mut memory = SlidingMemory { direct_failed: 1 };
         assert!(!solve_sliding(&mut p, &lengths, &normals, &mut s, &mut memory));
         assert!(max_stretch(&p, &lengths) < 1e-6, "{}", max_stretch(&p, &lengths));

@@ -16,12 +16,12 @@ mod scenes;
 
 use scenes::{
     ASLEEP, AWAKE_AT_REST, COLLIDERS, COLLIDERS_SCALAR, LIMP, LOD1, LOD2, PLAIN, PLAIN_SCALAR, ReadBack, Scene,
-    SceneRun, VIEWS,
+    SceneRun, VIEWS, VIEWS_COLLIDERS,
 };
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: scene_cost FRAMES 1x8|100x16|1000x16|16384x16|1x256|1x1000|1x1000_hair|ragged [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest|lod1|lod2|views|limp]";
+    let usage = "usage: scene_cost FRAMES 1x8|100x16|1000x16|16384x16|1x256|1x1000|1x1000_hair|ragged [lanes|scalar|colliders|colliders_scalar|asleep|awake_at_rest|lod1|lod2|views|views_colliders|limp]";
     let frames: u64 = args.first().and_then(|f| f.parse().ok()).expect(usage);
     let scene = match args.get(1).map(String::as_str) {
         Some("1x8") => Scene::uniform("1x8", 1, 8),
@@ -43,6 +43,7 @@ fn main() {
         Some("lod1") => LOD1,
         Some("lod2") => LOD2,
         Some("views") => VIEWS,
+        Some("views_colliders") => VIEWS_COLLIDERS,
         Some("limp") => LIMP,
         _ => PLAIN,
     };

@@ -1238,7 +1238,8 @@ mod tests {
     /// does not converge from so far off (as in the contact rounds of the report's 1000-joint rope). The lengths
     /// are then met from where it got to, near the given positions: within 1.5 times the least move that meets
     /// them (the exact projection's). Met from the given positions instead, the direct solve along the start
-    /// bonds met them by drawing the rope in along itself, about 30 000 times as far (sums of squared moves).
+    /// bonds met them by drawing the rope in along itself, about 30 000 times as far (sums of squared moves;
+    /// `cargo test --release --lib a_failed_sliding -- --nocapture` prints both).
     #[test]
     fn a_failed_sliding_projection_hands_on_its_progress() {
         let (n, segment) = (400, 8e-4);
@@ -1279,6 +1280,17 @@ mod tests {
         assert!(implicit::project(&mut nearest, &l2, &inv_l2, TOLERANCE, &mut s.implicit));
         let (least, solved) = (moved(&nearest), moved(&p));
         assert!(solved <= 1.5 * least, "the solve moved the joints by {solved:.3e} m^2, the least move is {least:.3e}");
+        // What the solve did before: the unrestricted solve from the given positions.
+        let mut from_given = given.clone();
+        prepare(&x, &lengths, &mut s);
+        solve_prepared(&mut from_given, &lengths, &mut s);
+        let before = moved(&from_given);
+        println!(
+            "moved {solved:.3e} m^2 ({:.2} times the least), from the given positions {before:.3e} ({:.0} times)",
+            solved / least,
+            before / least
+        );
+        assert!(max_stretch(&from_given, &lengths) < 1e-6 && before > solved, "{before:.3e} against {solved:.3e}");
     }
 
     /// A chain whose restricted direct solve meets the lengths keeps trying it first.

@@ -8,6 +8,7 @@ use glam::{DVec3, Vec3};
 
 use super::buffers::reserve_total;
 use super::implicit::{self, ImplicitScratch};
+use super::stability::{Projection, TensionBudget};
 use super::warm_start::{MultiplierHistory, WARM_SLOTS};
 
 /// Relative error of `|b|^2 / l^2 - 1` below which a bond counts as satisfied: 5e-8 in length, the float32
@@ -59,11 +60,14 @@ struct NewtonScratch {
     step: Vec<f64>,
     /// The Gauss-Newton projection's rows of the system, before its elimination ([`TwistedPass`]).
     rows: Vec<BondRow>,
+    /// The largest multiplier of the last direct solve that converged, and whether the budget refused it.
+    tension: f64,
+    refused: bool,
 }
 
 impl ConstraintScratch {
     pub fn reserve(&mut self, bonds: usize) {
-        let NewtonScratch { mu, c_prime, d_prime, corrected, step, rows } = &mut self.newton;
+        let NewtonScratch { mu, c_prime, d_prime, corrected, step, rows, .. } = &mut self.newton;
         for v in [&mut self.length_squared, &mut self.inverse_length_squared, mu, c_prime, d_prime, step] {
             if v.len() < bonds {
                 v.resize(bonds, 0.0);
@@ -109,7 +113,8 @@ pub fn solve(x: &[DVec3], p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintSc
 
 /// [`solve`] with the previous positions given to the last [`prepare`] (with the same `lengths`).
 pub fn solve_prepared(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> bool {
-    solve_direct(p, lengths, s) == Solved::Direct
+    let mut unlimited = TensionBudget::UNLIMITED;
+    solve_direct(p, lengths, s, &mut unlimited) == Solved::Direct
 }
 
 /// Which solve met the lengths.
@@ -121,14 +126,25 @@ pub enum Solved {
     GaussSeidel,
 }
 
-fn solve_direct(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> Solved {
+/// The direct solve within `budget` ([`super::stability`]), or what takes over from it.
+fn solve_direct(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, budget: &mut TensionBudget) -> Solved {
     let m = lengths.len();
     debug_assert!(p.len() == m + 1 && s.start_bonds.len() >= m);
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
-    if newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, Start::Cold) {
+    let room = budget.room();
+    if newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, Start::Cold, room) {
+        budget.spend(s.newton.tension);
         return Solved::Direct;
     }
-    fall_back(p, lengths, s)
+    fall_back_within(p, lengths, s, budget)
+}
+
+/// After a direct solve that failed or that `budget` refused (either leaves `p` as it was, and its last
+/// multipliers in `s.newton.mu`): `fall_back`, from the projection the budget picks for the tension the direct
+/// solve ended with (for one that failed, the tension of its last step).
+fn fall_back_within(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, budget: &TensionBudget) -> Solved {
+    let tension = if s.newton.refused { s.newton.tension } else { largest_multiplier(&s.newton.mu[..lengths.len()]) };
+    fall_back(p, lengths, s, budget.projection(tension))
 }
 
 /// [`solve_direct`] from the multipliers `history` extrapolates ([`super::warm_start`]), or from none if it
@@ -137,13 +153,19 @@ fn solve_direct(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> 
 /// direct solve fails on such chains after two to four passes, some twice (warm, then cold; on the report's
 /// 1 x 1000 hair rope it took 20 % of the samples, `docs/robustness.md` bug 1), and a failed direct solve
 /// leaves `p` as it was, so the projection computes what it would have computed after it, to the bit.
-fn solve_warm(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, history: &mut MultiplierHistory) -> Solved {
+fn solve_warm(
+    p: &mut [DVec3],
+    lengths: &[f32],
+    s: &mut ConstraintScratch,
+    history: &mut MultiplierHistory,
+    budget: &mut TensionBudget,
+) -> Solved {
     let m = lengths.len();
     debug_assert!(p.len() == m + 1 && s.start_bonds.len() >= m);
     if relinearizes(history.relinearized) {
         // No direct solve's multipliers: the exact projection, if the Gauss-Newton one fails, starts from none.
         s.newton.mu[..m].fill(0.0);
-        let solved = fall_back(p, lengths, s);
+        let solved = fall_back(p, lengths, s, Projection::GaussNewton);
         history.relinearized = relinearized_after(history.relinearized, solved);
         return solved;
     }
@@ -154,11 +176,19 @@ fn solve_warm(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, histo
         Start::Cold
     };
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
-    let direct = newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, start)
-        // A warm start that failed tries again from none before the fallback, so that it never brings one on.
+    let room = budget.room();
+    let direct = newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, start, room)
+        // A warm start that failed tries again from none before the fallback, so that it never brings one on
+        // (one the budget refused met the lengths: from none it would meet them with the same tension).
         || (start == Start::Warm
-            && newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, Start::Cold));
-    let solved = if direct { Solved::Direct } else { fall_back(p, lengths, s) };
+            && !s.newton.refused
+            && newton_along_directions(p, &s.start_bonds[..m], &Free, l2, inv_l2, &mut s.newton, Start::Cold, room));
+    let solved = if direct {
+        budget.spend(s.newton.tension);
+        Solved::Direct
+    } else {
+        fall_back_within(p, lengths, s, budget)
+    };
     if solved == Solved::Direct {
         history.learn(&s.newton.mu[..m]);
     } else {
@@ -196,10 +226,13 @@ pub fn solve_again(
     s: &mut ConstraintScratch,
     memory: &mut SolveMemory,
     iteration: usize,
+    budget: &mut TensionBudget,
 ) -> bool {
     match memory.warm.get_mut(iteration) {
-        Some(history) if history.last.len() == lengths.len() => solve_warm(p, lengths, s, history) == Solved::Direct,
-        _ => solve_prepared(p, lengths, s),
+        Some(history) if history.last.len() == lengths.len() => {
+            solve_warm(p, lengths, s, history, budget) == Solved::Direct
+        }
+        _ => solve_direct(p, lengths, s, budget) == Solved::Direct,
     }
 }
 
@@ -235,7 +268,16 @@ pub fn solve_sliding(
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
     let sliding = Sliding(normals);
     if memory.direct_failed.is_multiple_of(RETRY_DIRECT)
-        && newton_along_directions(p, &s.start_bonds[..m], &sliding, l2, inv_l2, &mut s.newton, Start::Cold)
+        && newton_along_directions(
+            p,
+            &s.start_bonds[..m],
+            &sliding,
+            l2,
+            inv_l2,
+            &mut s.newton,
+            Start::Cold,
+            f64::INFINITY,
+        )
     {
         memory.direct_failed = 0;
         return true;
@@ -379,15 +421,21 @@ impl SolveMemory {
 /// its first solves need the exact projection, this one goes straight to it, from the last one's tensions
 /// (the direct solve and the Gauss-Newton projection would fail first, and the start is closer), except every
 /// [`RETRY_DIRECT`]-th substep. Returns `false` when the direct solve was not used.
-pub fn solve_first(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, memory: &mut SolveMemory) -> bool {
+pub fn solve_first(
+    p: &mut [DVec3],
+    lengths: &[f32],
+    s: &mut ConstraintScratch,
+    memory: &mut SolveMemory,
+    budget: &mut TensionBudget,
+) -> bool {
     if exact_from_memory(p, lengths, s, memory) {
         memory.warm[0].forget_all();
         return false;
     }
     let solved = if memory.warm[0].last.len() == lengths.len() {
-        solve_warm(p, lengths, s, &mut memory.warm[0])
+        solve_warm(p, lengths, s, &mut memory.warm[0], budget)
     } else {
-        solve_direct(p, lengths, s)
+        solve_direct(p, lengths, s, budget)
     };
     memory.learn(solved, s, lengths.len());
     solved == Solved::Direct
@@ -481,27 +529,36 @@ fn set_lengths(lengths: &[f32], s: &mut ConstraintScratch) {
 
 /// What [`solve_prepared`] does when the direct solve fails, for a solver that ran its own direct solve (the
 /// lane path), whose last multipliers are `multipliers`: see `fall_back`.
-pub fn solve_fallback(p: &mut [DVec3], lengths: &[f32], multipliers: &[f64], s: &mut ConstraintScratch) -> Solved {
+pub fn solve_fallback(
+    p: &mut [DVec3],
+    lengths: &[f32],
+    multipliers: &[f64],
+    s: &mut ConstraintScratch,
+    first: Projection,
+) -> Solved {
     let m = lengths.len();
     set_lengths(lengths, s);
     s.newton.mu[..m].copy_from_slice(&multipliers[..m]);
-    fall_back(p, lengths, s)
+    fall_back(p, lengths, s, first)
 }
 
 /// After a failed direct solve (its last multipliers in `s.newton.mu`): the Gauss-Newton projection along
 /// the current bonds, cheap where it converges (hair-length segments); if it fails, the exact projection
 /// (`implicit`), which converges on the fine ropes that defeat both (bug 1); if even that fails,
-/// Gauss-Seidel sweeps from the positions the fallback was given.
-fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch) -> Solved {
+/// Gauss-Seidel sweeps from the positions the fallback was given. `first` at `Exact` skips the Gauss-Newton
+/// projection, where it would feed the chain's zig-zag ([`super::stability`]).
+fn fall_back(p: &mut [DVec3], lengths: &[f32], s: &mut ConstraintScratch, first: Projection) -> Solved {
     let m = lengths.len();
     let (l2, inv_l2) = (&s.length_squared[..m], &s.inverse_length_squared[..m]);
     // The Gauss-Newton projection moves `p`: the exact one starts from the positions and multipliers given.
     s.implicit.begin(p, &s.newton.mu[..m]);
-    for k in 0..m {
-        s.current_bonds[k] = p[k + 1] - p[k];
-    }
-    if project_relinearized(p, &mut s.current_bonds[..m], &Free, l2, inv_l2, &mut s.newton) {
-        return Solved::GaussNewton;
+    if first == Projection::GaussNewton {
+        for k in 0..m {
+            s.current_bonds[k] = p[k + 1] - p[k];
+        }
+        if project_relinearized(p, &mut s.current_bonds[..m], &Free, l2, inv_l2, &mut s.newton) {
+            return Solved::GaussNewton;
+        }
     }
     if implicit::project(p, l2, inv_l2, TOLERANCE, &mut s.implicit) {
         return Solved::Exact;
@@ -584,13 +641,17 @@ enum Start {
 /// Newton iterations on the multipliers `mu` of corrections along the directions `d` (one per bond):
 /// particle `j` moves by `d[j-1] mu[j-1] - d[j] mu[j]` (the root not at all), or by the part of that its
 /// `mobility` allows. Applies them to `p` and returns `true` when converged, leaves `p` untouched otherwise.
-/// On success `mu` holds the multipliers that moved `p` (none where the first pass found it converged).
+/// On success `mu` holds the multipliers that moved `p` (none where the first pass found it converged), and
+/// `s.tension` the largest of them. A solve that converged with a multiplier above `room` is refused: it
+/// returns `false` with `s.refused` set, `s.tension` and `mu` as it ended, and `p` untouched
+/// ([`super::stability`]).
 ///
 /// Each iteration is one pass root to tip that evaluates the bonds under the current multipliers and runs
 /// the forward elimination of the Thomas algorithm on the tridiagonal Newton system `J delta = -F/2`
 /// (`F_k = |b_k|^2 - l_k^2`, `J` the halved Jacobian `dF/dmu`), then one pass back. The elimination of the
 /// last, converged pass is wasted, but the fused pass reads every bond once and overlaps the elimination's
 /// chain of divisions with independent work.
+#[allow(clippy::too_many_arguments)]
 fn newton_along_directions(
     p: &mut [DVec3],
     d: &[DVec3],
@@ -599,9 +660,11 @@ fn newton_along_directions(
     inverse_length_squared: &[f64],
     s: &mut NewtonScratch,
     start: Start,
+    room: f64,
 ) -> bool {
     let m = d.len();
     let p = &mut p[..m + 1];
+    s.refused = false;
     let (l2, inv_l2) = (&length_squared[..m], &inverse_length_squared[..m]);
     let (mu, corrected, step) = (&mut s.mu[..m], &mut s.corrected[..m + 1], &mut s.step[..m]);
     let (c_prime, d_prime) = (&mut s.c_prime[..m], &mut s.d_prime[..m]);
@@ -625,6 +688,11 @@ fn newton_along_directions(
             }
         }
         if pass.converged(previous_worst) {
+            s.tension = largest_multiplier(mu);
+            if above(s.tension, room) {
+                s.refused = true;
+                return false;
+            }
             if iteration > 0 || warm {
                 p[1..].copy_from_slice(&corrected[1..]);
             }
@@ -652,6 +720,11 @@ fn newton_along_directions(
             return false;
         }
         if pass.worst <= LANDING_GATE && error_after_step(d, mobility, step, inv_l2) <= TOLERANCE {
+            s.tension = largest_multiplier(mu);
+            if above(s.tension, room) {
+                s.refused = true;
+                return false;
+            }
             // The pass that would confirm it computes these same positions.
             for j in 1..=m {
                 p[j] += shift(d, mobility, mu, j);
@@ -666,6 +739,20 @@ fn newton_along_directions(
 /// cold start's first pass met 1e-2 to 1e-1 on the benchmark scenes' hair, and from errors up to this Newton's
 /// next pass meets about their square).
 pub(crate) const TRUSTED_START: f64 = 1e-2;
+
+/// The largest multiplier by magnitude (the tension a direct solve carries, [`super::stability`]); a NaN one
+/// is passed over (the solve that ends with it has not converged).
+#[inline(always)]
+pub(crate) fn largest_multiplier(mu: &[f64]) -> f64 {
+    mu.iter().fold(0.0, |largest, mu| larger(largest, mu.abs()))
+}
+
+/// `b` if it is larger than `a`, else `a`: a plain comparison, which the lane solver's copy
+/// (`lanes::lengths::within_room`) vectorises to one maximum per bond (`f64::max` took 4 instructions a lane).
+#[inline(always)]
+pub(crate) fn larger(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
 
 /// Whether `error` is above `bound` or NaN.
 #[allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -974,6 +1061,11 @@ fn project_gauss_seidel(p: &mut [DVec3], lengths: &[f32]) {
 mod tests {
     use super::*;
 
+    /// No tension budget: these tests are about the solves themselves ([`super::super::stability`]).
+    fn unlimited() -> TensionBudget {
+        TensionBudget::UNLIMITED
+    }
+
     /// The Gauss-Newton step of bonds `d` from both ends at once ([`TwistedPass`]) against the one-ended
     /// Thomas solve of the same rows ([`ForwardPass`], [`back_substitute`]): every chain length from one bond,
     /// even and odd, free and with sliding particles. The two differ by rounding alone, and the passes' error
@@ -1067,7 +1159,16 @@ mod tests {
         let (d, l2, inv_l2) =
             (s.start_bonds[..m].to_vec(), s.length_squared[..m].to_vec(), s.inverse_length_squared[..m].to_vec());
         let mut stepped = p.clone();
-        assert!(newton_along_directions(&mut stepped, &d, &Free, &l2, &inv_l2, &mut s.newton, Start::Cold));
+        assert!(newton_along_directions(
+            &mut stepped,
+            &d,
+            &Free,
+            &l2,
+            &inv_l2,
+            &mut s.newton,
+            Start::Cold,
+            f64::INFINITY
+        ));
         let measured = (0..m)
             .map(|k| (((stepped[k + 1] - stepped[k]).length_squared() - l2[k]) * inv_l2[k]).abs())
             .fold(0.0, f64::max);
@@ -1095,7 +1196,7 @@ mod tests {
         prepare(&x, &lengths, &mut s);
         let mut cold = p.clone();
         let mut history = MultiplierHistory::new(n - 1);
-        assert_eq!(solve_warm(&mut cold, &lengths, &mut s, &mut history), Solved::Direct);
+        assert_eq!(solve_warm(&mut cold, &lengths, &mut s, &mut history, &mut unlimited()), Solved::Direct);
         assert!(history.remembered());
         (x, lengths, p, cold, history.last.clone())
     }
@@ -1108,7 +1209,7 @@ mod tests {
         let mut history = MultiplierHistory::new(lengths.len());
         history.learn(start);
         let mut warm = p.to_vec();
-        assert_eq!(solve_warm(&mut warm, lengths, &mut s, &mut history), Solved::Direct);
+        assert_eq!(solve_warm(&mut warm, lengths, &mut s, &mut history, &mut unlimited()), Solved::Direct);
         (warm, history)
     }
 
@@ -1412,13 +1513,13 @@ mod tests {
         prepare(&x, &lengths, &mut s);
         let mut history = MultiplierHistory::new(m);
         let mut first = p.clone();
-        assert_eq!(solve_warm(&mut first, &lengths, &mut s, &mut history), Solved::GaussNewton);
+        assert_eq!(solve_warm(&mut first, &lengths, &mut s, &mut history, &mut unlimited()), Solved::GaussNewton);
         assert!(max_stretch(&first, &lengths) < 1e-6, "{}", max_stretch(&first, &lengths));
         assert_eq!(history.relinearized, 1);
         for streak in 1..=RETRY_DIRECT {
             s.newton.corrected.fill(DVec3::NAN);
             let mut again = p.clone();
-            assert_eq!(solve_warm(&mut again, &lengths, &mut s, &mut history), Solved::GaussNewton);
+            assert_eq!(solve_warm(&mut again, &lengths, &mut s, &mut history, &mut unlimited()), Solved::GaussNewton);
             assert!(crate::core::rod::same_bits(&again, &first), "streak {streak}");
             assert_eq!(history.relinearized, streak + 1);
             let direct_ran = !s.newton.corrected[1].is_nan();
@@ -1427,7 +1528,7 @@ mod tests {
         // A prediction the direct solve meets, at a retry: the streak ends.
         history.relinearized = 2 * RETRY_DIRECT;
         let mut easy: Vec<DVec3> = x.iter().map(|v| *v - DVec3::Y * 1.7e-4 * (v.x / 0.025)).collect();
-        assert_eq!(solve_warm(&mut easy, &lengths, &mut s, &mut history), Solved::Direct);
+        assert_eq!(solve_warm(&mut easy, &lengths, &mut s, &mut history, &mut unlimited()), Solved::Direct);
         assert_eq!(history.relinearized, 0);
         // And forgetting the chain's memory (placed anew) ends one too.
         let mut memory = SolveMemory::new(m);

@@ -39,6 +39,7 @@ pub(crate) mod rest_carry;
 pub mod rod;
 pub mod shape;
 pub mod sketch;
+pub mod stability;
 pub mod warm_start;
 pub mod weights;
 

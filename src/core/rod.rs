@@ -13,6 +13,7 @@ use super::params::{ChainParams, EngineSettings};
 use super::polar::{extract_rotation, landing_angle};
 use super::rest_carry::carry_orientations;
 use super::shape::Shape;
+use super::stability::{self, TensionBudget};
 
 /// Warm-started rotation extraction (Newton steps where the problem is well conditioned) reaches float
 /// precision in 2-3 iterations and stops early once converged; the cap only bounds the worst case.
@@ -111,15 +112,22 @@ pub struct ChainConstants {
     pub gravity: Vec3,
     /// `a^2 / 5`: weight of particle orientations in the group matrix.
     pub orientation_weight: f32,
+    /// What the substep's shape-matching passes leave of a zig-zag: how much tension its direct lengths
+    /// solves may carry ([`stability`]).
+    pub zigzag_gain: f64,
 }
 
 impl ChainConstants {
     pub fn new(params: &ChainParams, settings: &EngineSettings, h: f32, iterations: u32) -> Self {
+        let alpha_per_iteration = params.alpha_per_iteration(h, iterations);
+        // Without shape matching a substep runs one iteration (`substep`).
+        let passes = if alpha_per_iteration > 0.0 { iterations.max(1) } else { 1 };
         Self {
-            alpha_per_iteration: params.alpha_per_iteration(h, iterations),
+            alpha_per_iteration,
             velocity_decay: elementary::exp(-params.damping * h),
             gravity: settings.gravity * (params.gravity_scale * settings.scale),
             orientation_weight: (params.radius * settings.scale).powi(2) / 5.0,
+            zigzag_gain: stability::zigzag_gain(alpha_per_iteration, passes),
         }
     }
 }
@@ -237,6 +245,7 @@ pub fn substep(
     let alpha = input.constants.alpha_per_iteration;
     let iterations = if alpha > 0.0 { input.iterations.max(1) } else { 1 };
     state.solve_memory.begin_substep(h, iterations);
+    let mut budget = TensionBudget::new(input.constants.zigzag_gain);
     let mut report = SubstepReport::default();
     for iteration in 0..iterations {
         if alpha > 0.0 {
@@ -251,9 +260,9 @@ pub fn substep(
             );
         }
         let solved = if iteration == 0 {
-            inextensible::solve_first(p, lengths, constraints, &mut state.solve_memory)
+            inextensible::solve_first(p, lengths, constraints, &mut state.solve_memory, &mut budget)
         } else {
-            inextensible::solve_again(p, lengths, constraints, &mut state.solve_memory, iteration as usize)
+            inextensible::solve_again(p, lengths, constraints, &mut state.solve_memory, iteration as usize, &mut budget)
         };
         report.fallback |= !solved;
         if let Some(contacts) = &input.contacts {

@@ -68,6 +68,8 @@ pub struct LaneGroup<const L: usize> {
     pub(super) decay: F<L>,
     pub(super) gravity: V3<L>,
     pub(super) orientation_weight: F<L>,
+    /// `ChainConstants::zigzag_gain`.
+    pub(super) zigzag_gain: D<L>,
     pub(super) half_kick: Mask<L>,
     /// The anchor (position, rotation) at the end of each substep of the step.
     pub(super) anchors: Vec<(V3<L>, Q<L>)>,
@@ -79,6 +81,13 @@ pub struct LaneGroup<const L: usize> {
     pub(super) start_bonds: Vec<DV3<L>>,
     pub(super) corrected: Vec<DV3<L>>,
     pub(super) mu: Vec<D<L>>,
+    /// The tension budget of the substep's solves (`stability::TensionBudget`, lane by lane): what the direct
+    /// solves spent, the largest multiplier the next may end with, the largest multiplier each lane's last
+    /// converged direct solve ended with, and the lanes whose last direct solve the budget refused.
+    pub(super) tension_spent: D<L>,
+    pub(super) tension_room: D<L>,
+    pub(super) tension: D<L>,
+    pub(super) refused: Mask<L>,
     /// The direct solve's multiplier histories (`warm_start`), one per solve of a substep: each lane's
     /// chain's `SolveMemory::warm`, loaded and stored with it.
     pub(super) warm: [WarmLanes<L>; WARM_SLOTS],
@@ -143,6 +152,12 @@ impl<const L: usize> Default for V3<L> {
 }
 
 impl<const L: usize> Default for F<L> {
+    fn default() -> Self {
+        Self([0.0; L])
+    }
+}
+
+impl<const L: usize> Default for D<L> {
     fn default() -> Self {
         Self([0.0; L])
     }
@@ -310,6 +325,7 @@ impl<const L: usize> LaneGroup<L> {
             self.decay.0[lane] = constants.velocity_decay;
             self.gravity.set(lane, constants.gravity.to_array());
             self.orientation_weight.0[lane] = constants.orientation_weight;
+            self.zigzag_gain.0[lane] = constants.zigzag_gain;
             self.half_kick.0[lane] = chain.half_kick;
             self.memories[lane].copy_streak_from(&chain.state.solve_memory);
         }

@@ -14,6 +14,7 @@ use super::simd::{D, DV3, F, M3, Mask, Q, V3};
 use crate::core::inextensible::{self, SolveMemory, Solved};
 use crate::core::polar::landing_angle;
 use crate::core::rod::FINAL_CONTACT_ROUNDS;
+use crate::core::stability::{self, Projection};
 use crate::core::warm_start::WARM_SLOTS;
 
 /// The vector phases of a substep, each compiled as its own function (a copy per instruction set:
@@ -90,11 +91,13 @@ pub fn substep_with_contacts<const L: usize>(g: &mut LaneGroup<L>, s: usize, pha
                 let sliding = contacts::sliding(g, again);
                 let vector = again.and(sliding.not());
                 if vector.any() {
+                    // Restoring the lengths after the contacts: no budget (`stability::TensionBudget::UNLIMITED`).
+                    g.tension_room = D::splat(f64::INFINITY);
                     let solved = (phases.solve_lengths)(g, vector, None);
                     let failed = vector.and(solved.not());
                     if failed.any() {
                         fell_back = fell_back.or(failed);
-                        fall_back(g, failed, Mask([false; L]), false);
+                        fall_back(g, failed, Mask([false; L]), false, false);
                     }
                 }
                 if sliding.any() {
@@ -129,6 +132,7 @@ pub fn begin_substep<const L: usize>(g: &mut LaneGroup<L>, s: usize, predict: Pr
     let h = g.h;
     let (anchor_position, anchor_rotation) = g.anchors[s];
     start_bonds(g);
+    g.tension_spent = D::splat(0.0);
 
     // Kinematic root.
     g.p[0] = anchor_position.to_f64() + anchor_rotation.rotate(g.rest_root).to_f64();
@@ -167,7 +171,9 @@ fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>, iteration: 
         None => Mask([false; L]),
     };
     let direct = pending.and(relinearizing.not());
+    g.tension_room = g.zigzag_gain.zip(g.tension_spent, stability::room);
     let solved = (phases.solve_lengths)(g, direct, slot);
+    g.tension_spent = D::select(solved, g.tension_spent + g.tension, g.tension_spent);
     if remembering {
         for lane in (0..L).filter(|&lane| solved.0[lane]) {
             g.memories[lane].learn(Solved::Direct, &g.constraints, g.n - 1);
@@ -175,7 +181,7 @@ fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>, iteration: 
     }
     let failed = direct.and(solved.not());
     let falling_back = failed.or(relinearizing).any();
-    let ended = if falling_back { fall_back(g, failed, relinearizing, first) } else { [None; L] };
+    let ended = if falling_back { fall_back(g, failed, relinearizing, first, true) } else { [None; L] };
     if let Some(slot) = slot.filter(|_| falling_back || streaking.is_some()) {
         // Every lane's streak as `inextensible::relinearized_after` leaves it; a lane that did not fall back
         // ended in the direct solve or the exact projection from memory (`solve_first`), which ends it.
@@ -350,13 +356,15 @@ fn pull_to_goal<const L: usize>(p: DV3<L>, centre: DV3<L>, offset: V3<L>, alpha:
 
 /// The scalar fallback for every lane in `failed` (from its direct solve's last multipliers) and in
 /// `relinearizing` (from none: it skipped the direct solve), one lane at a time; a substep's first solve
-/// (`learn`) also updates the lane's solve memory. Returns how each of those lanes' solve ended.
+/// (`learn`) also updates the lane's solve memory. A `budgeted` solve (one of the iterations', not a contact
+/// round's) falls back to the projection its tension calls for. Returns how each of those lanes' solve ended.
 #[cold]
 fn fall_back<const L: usize>(
     g: &mut LaneGroup<L>,
     failed: Mask<L>,
     relinearizing: Mask<L>,
     learn: bool,
+    budgeted: bool,
 ) -> [Option<Solved>; L] {
     let n = g.n;
     let mut ended = [None; L];
@@ -373,7 +381,16 @@ fn fall_back<const L: usize>(
         } else {
             g.lane_mu.extend(g.mu[..n - 1].iter().map(|mu| mu.0[lane]));
         }
-        let solved = inextensible::solve_fallback(&mut g.lane_p, &g.lane_lengths, &g.lane_mu, &mut g.constraints);
+        // After a direct solve, the projection its tension calls for (`inextensible::fall_back_within`).
+        let first = if budgeted && failed.0[lane] {
+            let tension =
+                if g.refused.0[lane] { g.tension.0[lane] } else { inextensible::largest_multiplier(&g.lane_mu) };
+            stability::projection(g.zigzag_gain.0[lane], g.tension_spent.0[lane] + tension)
+        } else {
+            Projection::GaussNewton
+        };
+        let solved =
+            inextensible::solve_fallback(&mut g.lane_p, &g.lane_lengths, &g.lane_mu, &mut g.constraints, first);
         if learn {
             g.memories[lane].learn(solved, &g.constraints, n - 1);
         }

@@ -69,10 +69,12 @@ pub fn solve_lengths<const L: usize>(
         }
         _ => zero_multipliers(g, m, lanes),
     }
+    g.refused = Mask([false; L]);
     let mut solved = newton(g, lanes, started, passes);
     if let Some(slot) = warm {
-        // As `inextensible::solve_warm`: a warm start that failed tries again from none before the fallback.
-        let retry = started.and(solved.not());
+        // As `inextensible::solve_warm`: a warm start that failed tries again from none before the fallback
+        // (not one the budget refused: it met the lengths).
+        let retry = started.and(solved.not()).and(g.refused.not());
         if retry.any() {
             zero_multipliers(g, m, retry);
             solved = solved.or(newton(g, retry, Mask([false; L]), passes));
@@ -102,6 +104,8 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
         let pass = forward_pass(g, iteration, corrected, passes);
         let converged = active.and(pass.converged(previous_worst));
         if converged.any() {
+            let converged = within_room(g, m, converged);
+            active = active.and(g.refused.not());
             if corrected {
                 take_corrected(g, m, converged);
             }
@@ -157,6 +161,8 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
         if near.any() {
             let landed = near.and(after.le(D::splat(TOLERANCE)));
             if landed.any() {
+                let landed = within_room(g, m, landed);
+                active = active.and(g.refused.not());
                 take_corrected(g, m, landed);
                 solved = solved.or(landed);
                 active = active.and(landed.not());
@@ -167,6 +173,20 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
         }
     }
     solved
+}
+
+/// The lanes of `lanes` (whose solve converged) that the tension budget admits (`inextensible::newton_along_directions`
+/// with its `room`); it refuses the others (`g.refused`). Records each of them's largest multiplier (`g.tension`).
+#[inline(always)]
+fn within_room<const L: usize>(g: &mut LaneGroup<L>, m: usize, lanes: Mask<L>) -> Mask<L> {
+    // `inextensible::largest_multiplier`, lane by lane: the same operations in the same order.
+    let largest =
+        g.mu[..m].iter().fold(D::splat(0.0), |largest, mu| largest.zip(mu.abs(), crate::core::inextensible::larger));
+    g.tension = D::select(lanes, largest, g.tension);
+    // `le`: a NaN is refused, as `!(tension <= room)` refuses it.
+    let fits = largest.le(g.tension_room);
+    g.refused = g.refused.or(lanes.and(fits.not()));
+    lanes.and(fits)
 }
 
 /// `MultiplierHistory::learn` on the lanes of `solved`, `forget` on the others.

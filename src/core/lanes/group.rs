@@ -13,6 +13,7 @@ use crate::core::inextensible::{ConstraintScratch, SolveMemory};
 use crate::core::math::Transform;
 use crate::core::rod::{ChainConstants, RodState};
 use crate::core::shape::Shape;
+use crate::core::stability;
 use crate::core::warm_start::WARM_SLOTS;
 
 /// What one chain brings to a lane group for one step.
@@ -68,8 +69,9 @@ pub struct LaneGroup<const L: usize> {
     pub(super) decay: F<L>,
     pub(super) gravity: V3<L>,
     pub(super) orientation_weight: F<L>,
-    /// `ChainConstants::zigzag_gain`.
+    /// `ChainConstants::zigzag_gain`, and the tension it allows a substep's direct solves (`stability`).
     pub(super) zigzag_gain: D<L>,
+    pub(super) tension_limit: D<L>,
     pub(super) half_kick: Mask<L>,
     /// The anchor (position, rotation) at the end of each substep of the step.
     pub(super) anchors: Vec<(V3<L>, Q<L>)>,
@@ -326,6 +328,7 @@ impl<const L: usize> LaneGroup<L> {
             self.gravity.set(lane, constants.gravity.to_array());
             self.orientation_weight.0[lane] = constants.orientation_weight;
             self.zigzag_gain.0[lane] = constants.zigzag_gain;
+            self.tension_limit.0[lane] = stability::direct_limit(constants.zigzag_gain);
             self.half_kick.0[lane] = chain.half_kick;
             self.memories[lane].copy_streak_from(&chain.state.solve_memory);
         }

@@ -171,7 +171,7 @@ fn iterate<const L: usize>(g: &mut LaneGroup<L>, phases: &Phases<L>, iteration: 
         None => Mask([false; L]),
     };
     let direct = pending.and(relinearizing.not());
-    g.tension_room = g.zigzag_gain.zip(g.tension_spent, stability::room);
+    g.tension_room = g.tension_limit - g.tension_spent;
     let solved = (phases.solve_lengths)(g, direct, slot);
     g.tension_spent = D::select(solved, g.tension_spent + g.tension, g.tension_spent);
     if remembering {

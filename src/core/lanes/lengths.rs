@@ -105,7 +105,9 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
         let converged = active.and(pass.converged(previous_worst));
         if converged.any() {
             let converged = within_room(g, m, converged);
-            active = active.and(g.refused.not());
+            if g.refused.any() {
+                active = active.and(g.refused.not());
+            }
             if corrected {
                 take_corrected(g, m, converged);
             }
@@ -162,7 +164,9 @@ fn newton<const L: usize>(g: &mut LaneGroup<L>, lanes: Mask<L>, started: Mask<L>
             let landed = near.and(after.le(D::splat(TOLERANCE)));
             if landed.any() {
                 let landed = within_room(g, m, landed);
-                active = active.and(g.refused.not());
+                if g.refused.any() {
+                    active = active.and(g.refused.not());
+                }
                 take_corrected(g, m, landed);
                 solved = solved.or(landed);
                 active = active.and(landed.not());
@@ -183,10 +187,12 @@ fn within_room<const L: usize>(g: &mut LaneGroup<L>, m: usize, lanes: Mask<L>) -
     let largest =
         g.mu[..m].iter().fold(D::splat(0.0), |largest, mu| largest.zip(mu.abs(), crate::core::inextensible::larger));
     g.tension = D::select(lanes, largest, g.tension);
-    // `le`: a NaN is refused, as `!(tension <= room)` refuses it.
-    let fits = largest.le(g.tension_room);
-    g.refused = g.refused.or(lanes.and(fits.not()));
-    lanes.and(fits)
+    // `le`: a NaN is refused, as `inextensible::above` refuses it.
+    let admitted = lanes.and(largest.le(g.tension_room));
+    if admitted != lanes {
+        g.refused = g.refused.or(lanes.and(admitted.not()));
+    }
+    admitted
 }
 
 /// `MultiplierHistory::learn` on the lanes of `solved`, `forget` on the others.
